@@ -1,0 +1,40 @@
+#pragma once
+// HeightField: the scene's initial surface as a function z(x, y) over the domain -- flat,
+// seeded procedural dunes, or a 16-bit PNG heightmap stretched over the domain. Back-ends
+// build their models from it; schedules use it for the tool depth. Evaluation is O(1).
+#include <cstdint>
+#include <vector>
+
+#include "common/scene.hpp"
+
+namespace sb {
+
+class HeightField {
+ public:
+  static HeightField from_scene(const Scene& scene);  // throws InputError for a bad PNG
+  static HeightField flat(const DomainSpec& domain, double height_m);
+
+  double operator()(const Vec2& p) const;
+  const DomainSpec& domain() const { return domain_; }
+  // The smallest horizontal detail worth resolving: the heightmap pixel, a fraction of the
+  // shortest dune wavelength, or the domain for a flat terrain.
+  double feature_m() const { return feature_m_; }
+
+ private:
+  struct Ridge {
+    Vec2 wave;   // direction * 2 pi / wavelength
+    double phase;
+    double weight;
+  };
+  DomainSpec domain_;
+  TerrainKind kind_ = TerrainKind::Flat;
+  double base_m_ = 0.0;
+  double amplitude_m_ = 0.0;
+  std::vector<Ridge> ridges_;
+  double ridge_weight_sum_ = 1.0;
+  std::size_t img_w_ = 0, img_h_ = 0;
+  std::vector<double> img_;  // heights, row 0 at the domain's minimum y
+  double feature_m_ = 1.0;
+};
+
+}  // namespace sb

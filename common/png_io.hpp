@@ -1,0 +1,25 @@
+#pragma once
+// PNG reading and writing through libpng: 16-bit grey heightmaps and 8-bit RGB images.
+// Writers go through write_atomically, so a file appears whole or not at all.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace sb {
+
+struct Png16 {
+  std::size_t width = 0, height = 0;
+  std::vector<std::uint16_t> values;  // row-major, row 0 at the top of the image
+};
+
+// Throws InputError naming `field` when the file is missing, not a PNG, or not 16-bit grey.
+Png16 read_png16(const std::filesystem::path& file, const std::string& field);
+// `text` entries become tEXt chunks (key, value).
+void write_png16(const std::filesystem::path& file, const Png16& image,
+                 const std::vector<std::pair<std::string, std::string>>& text = {});
+// rgb: width * height * 3 bytes, row 0 at the top.
+void write_png_rgb(const std::filesystem::path& file, std::size_t width, std::size_t height,
+                   const std::vector<std::uint8_t>& rgb);
+
+}  // namespace sb

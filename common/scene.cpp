@@ -1,0 +1,367 @@
+#include "common/scene.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <toml++/toml.h>
+
+#include "common/input_error.hpp"
+
+namespace sb {
+
+std::string to_string(TerrainKind k) {
+  switch (k) {
+    case TerrainKind::Flat: return "flat";
+    case TerrainKind::Dunes: return "dunes";
+    case TerrainKind::Heightmap: return "heightmap";
+  }
+  return "?";
+}
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// An interval with open or closed ends, printed in error messages as "(0, 10]".
+struct Range {
+  double lo = -kInf, hi = kInf;
+  bool lo_open = false, hi_open = false;
+  bool contains(double v) const {
+    return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+  }
+  std::string str() const {
+    auto num = [](double v) {
+      if (std::isinf(v)) return std::string(v > 0 ? "inf" : "-inf");
+      std::ostringstream s;
+      s << v;
+      return s.str();
+    };
+    return (lo_open ? "(" : "[") + num(lo) + ", " + num(hi) + (hi_open ? ")" : "]");
+  }
+};
+Range positive(double hi = kInf) { return {0.0, hi, true, hi == kInf}; }
+Range closed(double lo, double hi) { return {lo, hi, false, false}; }
+Range open(double lo, double hi) { return {lo, hi, true, true}; }
+
+std::string describe(const toml::node& n) {
+  std::ostringstream s;
+  if (n.is_string()) {
+    s << '"' << *n.value<std::string>() << '"';
+  } else if (n.is_table()) {
+    s << "a table";
+  } else {
+    n.visit([&](auto&& v) { s << v; });
+  }
+  return s.str();
+}
+
+// Reads typed fields by dotted key, remembers which keys were read, and at the end reports
+// any key that nothing read (a typo, or a key of another version).
+class Fields {
+ public:
+  explicit Fields(const toml::table& root) : root_(root) {}
+
+  const toml::node* find(const std::string& key) {
+    seen_.insert(key);
+    return root_.at_path(key).node();
+  }
+
+  double number(const std::string& key, double fallback, Range range, bool required = false) {
+    const toml::node* n = find(key);
+    if (!n) {
+      if (required) fail(key, "is missing; it must be a number in " + range.str());
+      return fallback;
+    }
+    if (!n->is_number()) fail(key, "= " + describe(*n) + " must be a number in " + range.str());
+    const double v = *n->value<double>();
+    if (!std::isfinite(v)) fail(key, "= " + describe(*n) + " must be a finite number in " + range.str());
+    if (!range.contains(v)) fail(key, "= " + describe(*n) + " is out of range " + range.str());
+    return v;
+  }
+
+  long long integer(const std::string& key, long long fallback, long long lo, long long hi) {
+    const toml::node* n = find(key);
+    if (!n) return fallback;
+    const std::string allowed = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+    if (!n->is_integer()) fail(key, "= " + describe(*n) + " must be " + allowed);
+    const long long v = *n->value<long long>();
+    if (v < lo || v > hi) fail(key, "= " + describe(*n) + " is out of range: must be " + allowed);
+    return v;
+  }
+
+  bool boolean(const std::string& key, bool fallback) {
+    const toml::node* n = find(key);
+    if (!n) return fallback;
+    if (!n->is_boolean()) fail(key, "= " + describe(*n) + " must be true or false");
+    return *n->value<bool>();
+  }
+
+  std::string choice(const std::string& key, const std::string& fallback,
+                     const std::vector<std::string>& allowed) {
+    const toml::node* n = find(key);
+    std::string list;
+    for (const auto& a : allowed) list += (list.empty() ? "" : " | ") + a;
+    if (!n) return fallback;
+    if (!n->is_string()) fail(key, "= " + describe(*n) + " must be one of " + list);
+    const std::string v = *n->value<std::string>();
+    for (const auto& a : allowed)
+      if (a == v) return v;
+    fail(key, "= \"" + v + "\" is not allowed; must be one of " + list);
+    return v;
+  }
+
+  std::string string(const std::string& key, bool required) {
+    const toml::node* n = find(key);
+    if (!n) {
+      if (required) fail(key, "is missing; it must be a string");
+      return {};
+    }
+    if (!n->is_string() || n->value<std::string>()->empty())
+      fail(key, "= " + describe(*n) + " must be a non-empty string");
+    return *n->value<std::string>();
+  }
+
+  // An array of numbers; `count` 0 means any length >= min_count.
+  std::vector<double> numbers(const std::string& key, std::size_t count, std::size_t min_count,
+                              Range range, bool required, std::vector<double> fallback = {}) {
+    const toml::node* n = find(key);
+    const std::string shape = count ? std::to_string(count) + " numbers" : "at least " + std::to_string(min_count) + " numbers";
+    if (!n) {
+      if (required) fail(key, "is missing; it must be an array of " + shape + " in " + range.str());
+      return fallback;
+    }
+    const toml::array* arr = n->as_array();
+    if (!arr) fail(key, "= " + describe(*n) + " must be an array of " + shape);
+    if ((count && arr->size() != count) || arr->size() < min_count)
+      fail(key, "has " + std::to_string(arr->size()) + " elements; it must have " + shape);
+    std::vector<double> out;
+    for (std::size_t i = 0; i < arr->size(); ++i) {
+      const toml::node& e = *arr->get(i);
+      const std::string at = key + "[" + std::to_string(i) + "]";
+      if (!e.is_number()) fail(at, "= " + describe(e) + " must be a number in " + range.str());
+      const double v = *e.value<double>();
+      if (!std::isfinite(v) || !range.contains(v))
+        fail(at, "= " + describe(e) + " must be a finite number in " + range.str());
+      out.push_back(v);
+    }
+    return out;
+  }
+
+  Vec2 vec2(const std::string& key, Vec2 fallback, Range range, bool required = false) {
+    auto v = numbers(key, 2, 2, range, required, {fallback.x(), fallback.y()});
+    return {v[0], v[1]};
+  }
+
+  std::vector<Vec2> points(const std::string& key, std::size_t min_count, bool required) {
+    const toml::node* n = find(key);
+    if (!n) {
+      if (required) fail(key, "is missing; it must be an array of [x, y] points");
+      return {};
+    }
+    const toml::array* arr = n->as_array();
+    if (!arr || arr->size() < min_count)
+      fail(key, "must be an array of at least " + std::to_string(min_count) + " [x, y] points");
+    std::vector<Vec2> out;
+    for (std::size_t i = 0; i < arr->size(); ++i) {
+      const toml::array* p = arr->get(i)->as_array();
+      const std::string at = key + "[" + std::to_string(i) + "]";
+      if (!p || p->size() != 2 || !p->get(0)->is_number() || !p->get(1)->is_number())
+        fail(at, "= " + describe(*arr->get(i)) + " must be an [x, y] pair of numbers");
+      const double x = *p->get(0)->value<double>(), y = *p->get(1)->value<double>();
+      if (!std::isfinite(x) || !std::isfinite(y)) fail(at, "must hold finite numbers");
+      out.emplace_back(x, y);
+    }
+    return out;
+  }
+
+  // Every leaf key present in the file must have been read.
+  void reject_unknown() const { walk(root_, ""); }
+
+  [[noreturn]] static void fail(const std::string& key, const std::string& what) {
+    throw InputError("scene: " + key + " " + what);
+  }
+
+ private:
+  void walk(const toml::table& t, const std::string& prefix) const {
+    for (auto&& [k, v] : t) {
+      const std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+      if (const toml::table* sub = v.as_table()) {
+        walk(*sub, key);
+      } else if (!seen_.count(key)) {
+        fail(key, "is not a known key (see the scene format in README.md)");
+      }
+    }
+  }
+
+  const toml::table& root_;
+  std::set<std::string> seen_;
+};
+
+void apply_override(toml::table& root, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError("--set " + assignment + ": expected key=value, e.g. tool.radius_m=0.02");
+  const std::string key = assignment.substr(0, eq);
+  const std::string value = assignment.substr(eq + 1);
+  // The value is TOML ("0.02", "[1, 2]", "true", "\"disk\""); a bare word is a string.
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + value);
+  } catch (const toml::parse_error&) {
+    parsed = toml::table{{"v", value}};
+  }
+  toml::table* t = &root;
+  std::size_t start = 0;
+  for (std::size_t dot; (dot = key.find('.', start)) != std::string::npos; start = dot + 1) {
+    const std::string part = key.substr(start, dot - start);
+    toml::node* child = t->get(part);
+    if (!child) {
+      t->insert(part, toml::table{});
+      child = t->get(part);
+    }
+    t = child->as_table();
+    if (!t) throw InputError("--set " + assignment + ": " + key.substr(0, dot) + " is not a table");
+  }
+  t->insert_or_assign(key.substr(start), std::move(*parsed.get("v")));
+}
+
+void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
+  // [domain]
+  s.domain.origin_m = f.vec2("domain.origin_m", {0.0, 0.0}, open(-1e9, 1e9));
+  s.domain.size_m = f.vec2("domain.size_m", {}, positive(1e6), /*required=*/true);
+  const double extent = std::max(s.domain.size_m.x(), s.domain.size_m.y());
+
+  // [terrain]
+  const std::string kind = f.choice("terrain.kind", "flat", {"flat", "dunes", "heightmap"});
+  s.terrain.kind = kind == "flat" ? TerrainKind::Flat : kind == "dunes" ? TerrainKind::Dunes : TerrainKind::Heightmap;
+  s.terrain.height_m = f.number("terrain.height_m", 0.1, open(-1e6, 1e6));
+  if (s.terrain.kind == TerrainKind::Dunes) {
+    s.terrain.dune_amplitude_m = f.number("terrain.amplitude_m", 0.02, closed(0.0, 1e3));
+    s.terrain.dune_wavelength_m = f.number("terrain.wavelength_m", 0.2, positive(1e6));
+    s.terrain.dune_components = static_cast<int>(f.integer("terrain.components", 4, 1, 64));
+    s.terrain.seed = f.integer("terrain.seed", 1, 0, std::numeric_limits<long long>::max());
+  }
+  if (s.terrain.kind == TerrainKind::Heightmap) {
+    std::filesystem::path p = f.string("terrain.path", /*required=*/true);
+    s.terrain.heightmap_path = p.is_absolute() ? p : base_dir / p;
+    s.terrain.vertical_scale_m = f.number("terrain.vertical_scale_m", 0.1, positive(1e6));
+  }
+
+  // [material]
+  s.material.critical_angle_deg = f.number("material.critical_angle_deg", 30.0, open(0.0, 90.0));
+  s.material.transfer_fraction = f.number("material.transfer_fraction", 0.5, {0.0, 2.0, true, false});
+  s.material.stiffness_n_per_m = f.number("material.stiffness_n_per_m", 800.0, closed(0.0, 1e6));
+  s.material.drag_n_s_per_m = f.number("material.drag_n_s_per_m", 5.0, closed(0.0, 1e4));
+  s.material.friction = f.number("material.friction", 0.4, closed(0.0, 10.0));
+
+  // [erosion]
+  s.erosion.max_passes_per_step = static_cast<int>(f.integer("erosion.max_passes_per_step", 4, 0, 100000));
+  s.erosion.idle_passes = static_cast<int>(f.integer("erosion.idle_passes", 2, 1, 1000));
+  s.erosion.settle_tolerance_deg = f.number("erosion.settle_tolerance_deg", 0.1, closed(0.0, 10.0));
+  s.erosion.relax_at_end = f.boolean("erosion.relax_at_end", true);
+  s.erosion.relax_max_passes = static_cast<int>(f.integer("erosion.relax_max_passes", 20000, 0, 100000000));
+
+  // [tool]
+  const std::string shape = f.choice("tool.shape", "disk", {"disk", "box", "ellipse", "polygon", "pour"});
+  ToolSpec& t = s.tool;
+  t.shape = shape == "disk" ? ToolShape::Disk : shape == "box" ? ToolShape::Box
+          : shape == "ellipse" ? ToolShape::Ellipse : shape == "polygon" ? ToolShape::Polygon : ToolShape::Pour;
+  const Range tool_size = positive(extent * 10.0);
+  if (t.shape == ToolShape::Disk || t.shape == ToolShape::Pour)
+    t.radius_m = f.number("tool.radius_m", 0.02, tool_size);
+  if (t.shape == ToolShape::Box || t.shape == ToolShape::Ellipse) {
+    const Vec2 size = f.vec2("tool.size_m", {0.04, 0.02}, tool_size, /*required=*/true);
+    t.half_size_m = size / 2.0;
+  }
+  if (t.shape == ToolShape::Polygon) {
+    t.polygon_m = f.points("tool.polygon_m", 3, /*required=*/true);
+    if (!is_simple_polygon(t.polygon_m))
+      Fields::fail("tool.polygon_m", "must be a simple polygon (no self-intersections, non-zero area)");
+  }
+  if (t.shape == ToolShape::Disk || t.shape == ToolShape::Ellipse)
+    t.sides = static_cast<int>(f.integer("tool.sides", 32, 3, 4096));
+  if (t.shape == ToolShape::Pour) {
+    t.pour_volume_m3 = f.number("tool.volume_m3", 0.0, positive(1e9), /*required=*/true);
+  } else {
+    t.depth_m = f.number("tool.depth_m", 0.01, open(-1e6, 1e6));
+    const std::string profile = f.choice("tool.profile", "flat", {"flat", "sphere_cap"});
+    t.profile = profile == "flat" ? BottomProfile::Flat : BottomProfile::SphereCap;
+    if (t.profile == BottomProfile::SphereCap)
+      t.sphere_radius_m = f.number("tool.sphere_radius_m", 0.05, tool_size);
+    t.rim.width_m = f.number("tool.rim_width_m", 0.5 * (t.shape == ToolShape::Disk ? t.radius_m : t.half_size_m.minCoeff()), tool_size);
+    t.rim.forward_bias = f.number("tool.rim_forward_bias", 0.8, closed(0.0, 1.0));
+  }
+
+  // [stroke]
+  s.stroke.path_m = f.points("stroke.path_m", 1, /*required=*/true);
+  s.stroke.z_m = f.numbers("stroke.z_m", 0, 1, open(-1e9, 1e9), false);
+  if (!s.stroke.z_m.empty() && s.stroke.z_m.size() != s.stroke.path_m.size())
+    Fields::fail("stroke.z_m", "has " + std::to_string(s.stroke.z_m.size()) + " values; it needs one per waypoint (" +
+                 std::to_string(s.stroke.path_m.size()) + ")");
+  s.stroke.spacing_m = f.number("stroke.spacing_m", 0.005, positive(extent * 10.0));
+  s.stroke.repeat = static_cast<int>(f.integer("stroke.repeat", 1, 1, 1000000));
+  const double length = polyline_length(s.stroke.path_m);
+  if (length / s.stroke.spacing_m * s.stroke.repeat > 1e7)
+    Fields::fail("stroke.spacing_m", "gives more than 1e7 stamps for this path; use a larger spacing");
+
+  // [tin]
+  s.tin.alpha_flat_deg = f.number("tin.alpha_flat_deg", 0.4, closed(0.0, 45.0));
+  s.tin.tolerance_m = f.number("tin.tolerance_m", 0.001, positive(1e6));
+  s.tin.conserve_volume = f.boolean("tin.conserve_volume", false);
+  s.tin.contour_subdivision_m = f.number("tin.contour_subdivision_m", 0.0, closed(0.0, extent));
+  s.tin.snap_m = f.number("tin.snap_m", 1e-6, closed(0.0, 1e-2));
+
+  // [grid]
+  s.grid.cell_m = f.number("grid.cell_m", 0.005, positive(extent));
+  const double cells = (s.domain.size_m.x() / s.grid.cell_m + 1) * (s.domain.size_m.y() / s.grid.cell_m + 1);
+  if (cells > 2e9) Fields::fail("grid.cell_m", "gives more than 2e9 cells for this domain");
+  s.grid.storage = f.choice("grid.storage", "double", {"float", "double"}) == "float" ? GridStorage::Float : GridStorage::Double;
+  s.grid.neighbours = static_cast<int>(f.integer("grid.neighbours", 8, 4, 8));
+  if (s.grid.neighbours != 4 && s.grid.neighbours != 8)
+    Fields::fail("grid.neighbours", "= " + std::to_string(s.grid.neighbours) + " is not allowed; must be 4 or 8");
+
+  // [output]
+  s.output.raster_m = f.number("output.raster_m", std::min(0.0025, extent / 100.0), positive(extent));
+  const double samples = (s.domain.size_m.x() / s.output.raster_m + 1) * (s.domain.size_m.y() / s.output.raster_m + 1);
+  if (samples > 1e8) Fields::fail("output.raster_m", "gives more than 1e8 raster samples for this domain");
+}
+
+}  // namespace
+
+Scene parse_scene(const std::string& text, const std::string& name,
+                  const std::vector<std::string>& overrides, const std::filesystem::path& base_dir) {
+  toml::table root;
+  try {
+    root = toml::parse(text, name);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream msg;
+    msg << name << ":" << e.source().begin.line << ":" << e.source().begin.column
+        << ": not valid TOML: " << e.description();
+    throw InputError(msg.str());
+  }
+  for (const auto& o : overrides) apply_override(root, o);
+
+  Scene s;
+  s.path = name;
+  s.text = text;
+  s.overrides = overrides;
+  Fields fields(root);
+  read_scene(fields, s, base_dir);
+  fields.reject_unknown();
+  std::ostringstream resolved;
+  resolved << root;
+  s.resolved = resolved.str();
+  return s;
+}
+
+Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError("scene: cannot read " + file.string());
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_scene(text.str(), file.string(), overrides, file.parent_path());
+}
+
+}  // namespace sb

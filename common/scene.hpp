@@ -1,0 +1,89 @@
+#pragma once
+// Scene: everything one run needs, loaded from a commented TOML file, validated field by
+// field (unknown keys, wrong types, NaN and out-of-range values raise InputError naming the
+// key), with `--set key=value` overrides applied before validation.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "common/geometry.hpp"
+#include "common/material.hpp"
+#include "common/schedule.hpp"
+#include "common/tool.hpp"
+
+namespace sb {
+
+enum class TerrainKind { Flat, Dunes, Heightmap };
+std::string to_string(TerrainKind k);
+
+struct DomainSpec {
+  Vec2 origin_m{0.0, 0.0};
+  Vec2 size_m{0.7071067811865476, 0.7071067811865476};
+  Aabb2 box() const { return {origin_m, origin_m + size_m}; }
+};
+
+struct TerrainSpec {
+  TerrainKind kind = TerrainKind::Flat;
+  double height_m = 0.1;          // flat height; base height for dunes and heightmaps
+  // dunes: a seeded sum of sinusoidal ridges
+  double dune_amplitude_m = 0.02;
+  double dune_wavelength_m = 0.2;
+  int dune_components = 4;
+  long long seed = 1;
+  // heightmap: 16-bit grey PNG stretched over the domain; z = height_m + v/65535 * scale
+  std::filesystem::path heightmap_path;
+  double vertical_scale_m = 0.1;
+};
+
+struct ErosionSpec {
+  int max_passes_per_step = 4;        // erosion passes over L_e after each stamp
+  int idle_passes = 2;                // an element leaves L_e after this many idle visits
+  double settle_tolerance_deg = 0.1;  // slopes up to critical + this count as stable
+  bool relax_at_end = true;           // after the stroke, erode until settled
+  int relax_max_passes = 20000;
+};
+
+struct TinSpec {
+  double alpha_flat_deg = 0.4;        // the paper's alpha_flat, read as degrees
+  double tolerance_m = 0.001;         // greedy insertion: max height error of the initial TIN
+  bool conserve_volume = false;       // compensate simplification and flip volume changes
+  double contour_subdivision_m = 0.0; // outer contour subdivision step; 0: tool polygon only
+  double snap_m = 1e-6;               // points closer than this to a vertex reuse it
+};
+
+enum class GridStorage { Float, Double };
+struct GridSpec {
+  double cell_m = 0.005;
+  GridStorage storage = GridStorage::Double;
+  int neighbours = 8;                 // 4 or 8
+};
+
+struct OutputSpec {
+  double raster_m = 0.0025;           // spacing of the common comparison raster
+};
+
+struct Scene {
+  std::string path;                   // as given
+  std::string text;                   // the file's text, verbatim
+  std::vector<std::string> overrides; // "key=value" as given to --set
+  std::string resolved;               // the effective scene (TOML) after overrides
+
+  DomainSpec domain;
+  TerrainSpec terrain;
+  Material material;
+  ErosionSpec erosion;
+  ToolSpec tool;
+  Stroke stroke;
+  TinSpec tin;
+  GridSpec grid;
+  OutputSpec output;
+};
+
+// Loads and validates a scene; throws InputError naming the offending key.
+Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
+// Same, from text (base_dir resolves relative heightmap paths).
+Scene parse_scene(const std::string& text, const std::string& name,
+                  const std::vector<std::string>& overrides = {},
+                  const std::filesystem::path& base_dir = {});
+
+}  // namespace sb

@@ -1,0 +1,91 @@
+#pragma once
+// The Terrain interface: one virtual call per operation (a stamp, an erosion step, a batch
+// of queries); hot loops stay inside the back-ends. Every implementation documents, in its
+// header, bytes per element and the cost of each operation.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "common/erosion.hpp"
+#include "common/geometry.hpp"
+#include "common/raster.hpp"
+#include "common/tool.hpp"
+
+namespace sb {
+
+struct StampReport {
+  double volume_removed_m3 = 0.0;    // cut out of the footprint
+  double volume_deposited_m3 = 0.0;  // put on the rim (equals removed) or poured
+  std::size_t elements_touched = 0;  // cells or triangles the tool touched
+  std::size_t vertices_inserted = 0;
+  std::size_t vertices_removed = 0;
+};
+
+struct ErosionBudget {
+  int max_passes = 4;  // passes over the active set in this call
+  std::size_t max_updates = std::numeric_limits<std::size_t>::max();  // element visits
+};
+
+struct ErosionReport {
+  int passes = 0;
+  std::size_t updates = 0;    // element visits (an element and its neighbours examined)
+  std::size_t transfers = 0;  // neighbour transfers made
+  std::size_t active = 0;     // active set size after the call (0: settled)
+  double volume_moved_m3 = 0.0;
+};
+
+struct SimplifyParams {
+  double alpha_flat_deg = 0.4;
+};
+
+struct SimplifyReport {
+  std::size_t candidates = 0;  // vertices examined (the paper's L_r)
+  std::size_t removed = 0;
+  double detect_s = 0.0;       // redundant-vertex detection time
+  double remove_s = 0.0;       // vertex removal time
+};
+
+struct ModelStats {
+  std::size_t vertices = 0;
+  std::size_t triangles = 0;
+  std::size_t constrained_edges = 0;
+  std::size_t cells = 0;
+  std::size_t bytes = 0;       // the model's own data, from its containers' capacities
+  std::uint64_t walk_steps = 0;  // point-location steps since construction (TIN)
+  std::size_t active = 0;      // erosion active set (L_e) size
+};
+
+// Triangles of a back-end's surface, for rendering and export.
+struct SurfaceMesh {
+  std::vector<Vec3> vertices;
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  std::vector<std::array<std::uint32_t, 2>> constrained_edges;
+};
+
+struct IntegrityReport {
+  std::vector<std::string> problems;
+  bool ok() const { return problems.empty(); }
+};
+
+class Terrain {
+ public:
+  virtual ~Terrain() = default;
+  virtual std::string_view name() const = 0;  // "tin", "grid"
+  virtual double height(const Vec2& p) const = 0;
+  virtual StampReport stamp(const ToolStamp& s) = 0;
+  virtual ErosionReport erode(const ErosionRule& rule, const ErosionBudget& budget) = 0;
+  virtual SimplifyReport simplify(const SimplifyParams& params) = 0;
+  virtual double volume() const = 0;  // exact integral of the surface above z = 0
+  virtual ModelStats stats() const = 0;
+  virtual SurfaceMesh mesh() const = 0;
+  virtual void sample(Raster& out) const = 0;  // heights at every raster point
+  virtual IntegrityReport check() const = 0;
+  // Steepest slope between neighbours (the graph erosion uses), in degrees. O(model).
+  virtual double max_slope_deg() const = 0;
+};
+
+}  // namespace sb

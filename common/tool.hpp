@@ -1,0 +1,75 @@
+#pragma once
+// Tools: a footprint polygon plus a bottom profile, posed in the world; and the pour tool.
+// A ToolStamp is one application of a tool at one pose: the unit the back-ends consume.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/geometry.hpp"
+
+namespace sb {
+
+enum class ToolShape { Disk, Box, Ellipse, Polygon, Pour };
+enum class BottomProfile { Flat, SphereCap };
+
+std::string to_string(ToolShape s);
+std::string to_string(BottomProfile p);
+
+// Where the displaced volume goes: a rim band just outside the footprint, weighted
+// towards the direction of motion (Sumner et al. 1999; Onoue & Nishita 2003).
+struct RimRule {
+  double width_m = 0.01;      // band width outside the footprint boundary
+  double forward_bias = 0.8;  // 0: uniform rim; 1: nothing behind the tool
+};
+
+struct ToolSpec {
+  ToolShape shape = ToolShape::Disk;
+  double radius_m = 0.02;            // disk radius; pour radius for the pour tool
+  Vec2 half_size_m{0.02, 0.01};      // box half sizes; ellipse semi-axes
+  std::vector<Vec2> polygon_m;       // polygon footprint, tool coordinates
+  int sides = 32;                    // n-gon sides for disk and ellipse
+  BottomProfile profile = BottomProfile::Flat;
+  double sphere_radius_m = 0.05;     // sphere-cap profile: sphere radius
+  double depth_m = 0.01;             // bottom depth below the initial surface
+  double pour_volume_m3 = 0.0;       // pour tool: volume added per stamp
+  RimRule rim;
+
+  // Footprint in tool coordinates (origin at the pose, x along the heading), CCW.
+  // Empty for the pour tool, which has no footprint.
+  std::vector<Vec2> footprint_local() const;
+};
+
+struct ToolPose {
+  Vec2 xy{0.0, 0.0};
+  double bottom_z = 0.0;    // lowest point of the tool bottom, m
+  double heading_rad = 0.0; // rotation of the footprint about z
+};
+
+struct ToolStamp {
+  std::uint32_t generation = 0;  // stamp index in its schedule, from 0
+  ToolPose pose;
+  Vec2 motion_dir{0.0, 0.0};     // unit direction of motion; zero for a stationary stamp
+  std::vector<Vec2> footprint;   // world coordinates, CCW; empty for a pour
+  BottomProfile profile = BottomProfile::Flat;
+  double sphere_radius_m = 0.0;
+  RimRule rim;
+  double pour_volume_m3 = 0.0;   // > 0 only for pours
+  double pour_radius_m = 0.0;
+
+  bool is_pour() const { return pour_volume_m3 > 0.0; }
+  // Height of the tool bottom at p (meaningful inside the footprint).
+  double bottom_z(const Vec2& p) const;
+  bool contains(const Vec2& p) const { return point_in_polygon(footprint, p); }
+  // Weight of the displaced-volume deposit at p: 0 inside the footprint and beyond the
+  // rim band, else (1 + bias cos(phi)) / (1 + bias) * taper, with phi the angle between
+  // the motion and (p - pose), and the taper falling linearly across the band.
+  double rim_weight(const Vec2& p) const;
+  // Footprint bounds grown by the rim band.
+  Aabb2 influence_bounds() const;
+};
+
+// Places a tool at a pose: transforms the footprint into the world.
+ToolStamp make_stamp(const ToolSpec& spec, const ToolPose& pose, const Vec2& motion_dir,
+                     std::uint32_t generation);
+
+}  // namespace sb
