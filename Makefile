@@ -1,0 +1,42 @@
+# sandbench: the two README commands (`make reproduce`, `make test`) and helpers.
+# Every target that builds first runs `deps`, which installs missing Debian packages.
+
+PRESET ?= release
+BUILD_DIR := build/$(PRESET)
+PYTHON := /usr/bin/python3
+JOBS ?= 2
+BENCH_FILTER ?= .
+FULL ?= 0
+
+.PHONY: all deps configure build test test-asan reproduce bench clean
+
+all: build
+
+deps:
+	@bash .ci/deps.sh
+
+configure: deps
+	@cmake --preset $(PRESET) >/dev/null
+
+build: configure
+	@cmake --build $(BUILD_DIR) -j$(JOBS)
+
+test: build
+	@ctest --test-dir $(BUILD_DIR) --output-on-failure -j$(JOBS) --timeout 900
+
+# The same suite under AddressSanitizer and UndefinedBehaviorSanitizer.
+test-asan:
+	@$(MAKE) --no-print-directory test PRESET=asan-ubsan
+
+reproduce: build
+	@$(PYTHON) experiments/reproduce.py --sandbench $(BUILD_DIR)/harness/sandbench --results results \
+		$(if $(filter 1,$(FULL)),--full,)
+
+bench: build
+	@for b in $(BUILD_DIR)/tests/*_bench; do \
+		echo "== $$b"; $$b --benchmark_filter='$(BENCH_FILTER)' --benchmark_repetitions=5 \
+			--benchmark_report_aggregates_only=true || exit 1; \
+	done
+
+clean:
+	@rm -rf build

@@ -1,0 +1,49 @@
+// `sandbench run SCENE --backend tin|grid [--out RUN.h5] [--json] [--set k=v ...]`
+#include <iostream>
+#include <memory>
+
+#include "common/input_error.hpp"
+#include "harness/cli_commands.hpp"
+#include "harness/cli_support.hpp"
+#include "harness/run_file.hpp"
+
+namespace sb::cli {
+
+namespace {
+struct RunOptions {
+  std::string scene;
+  std::string backend;
+  std::string out;
+  bool json = false;
+  std::vector<std::string> overrides;
+};
+
+void run_command(const RunOptions& o) {
+  PreparedScene prepared = prepare_scene(load_scene(o.scene, o.overrides));
+  const Variant variant = parse_variant(o.backend);
+  const std::filesystem::path out = o.out.empty() ? default_run_path(o.scene, variant.label) : std::filesystem::path(o.out);
+  if (out.has_parent_path() && !std::filesystem::is_directory(out.parent_path()))
+    throw InputError("--out " + out.string() + ": directory " + out.parent_path().string() + " does not exist");
+  VariantRun r = run_variant(variant, prepared, /*show_progress=*/true);
+  write_run_file(out, r.run, r.prepared, r.summary);
+  if (o.json) {
+    std::cout << r.summary.dump(2) << "\n";
+  } else {
+    for (const auto& [k, v] : r.summary.items()) std::cout << k << " = " << v.dump() << "\n";
+  }
+  std::cerr << "wrote " << out.string() << "\n";
+}
+}  // namespace
+
+void add_run_command(CLI::App& app) {
+  auto opts = std::make_shared<RunOptions>();
+  CLI::App* cmd = app.add_subcommand("run", "Run one back-end on a scene's stroke and write an HDF5 run file");
+  cmd->add_option("scene", opts->scene, "Scene file (TOML)")->required();
+  cmd->add_option("--backend", opts->backend, "tin | grid (optionally grid:key=value:...)")->required();
+  cmd->add_option("--out", opts->out, "Run file to write (default: <scene>-<backend>.h5)");
+  cmd->add_flag("--json", opts->json, "Print the summary as JSON on stdout");
+  cmd->add_option("--set", opts->overrides, "Override a scene key: --set tool.radius_m=0.03")->take_all();
+  cmd->callback([opts] { run_command(*opts); });
+}
+
+}  // namespace sb::cli

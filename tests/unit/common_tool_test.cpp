@@ -1,0 +1,83 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "common/tool.hpp"
+
+namespace sb {
+namespace {
+
+// Counts lattice points inside the footprint: area estimate from rasterisation.
+double rasterised_area(const ToolStamp& s, double h) {
+  const Aabb2 b = bounds(s.footprint);
+  std::size_t inside = 0;
+  for (double y = std::floor(b.lo.y() / h) * h + h / 2; y < b.hi.y(); y += h)
+    for (double x = std::floor(b.lo.x() / h) * h + h / 2; x < b.hi.x(); x += h)
+      inside += s.contains({x, y});
+  return static_cast<double>(inside) * h * h;
+}
+
+TEST(Footprint, DiskIsAnNgonWithTheNgonsArea) {
+  ToolSpec t;
+  t.radius_m = 0.02;
+  t.sides = 32;
+  const auto poly = t.footprint_local();
+  ASSERT_EQ(poly.size(), 32u);
+  const double ngon = 0.5 * 32 * 0.02 * 0.02 * std::sin(2 * std::numbers::pi / 32);
+  EXPECT_NEAR(signed_area(poly), ngon, 1e-15);  // counter-clockwise
+}
+
+TEST(Footprint, RasterisationMatchesPolygonArea) {
+  for (ToolShape shape : {ToolShape::Disk, ToolShape::Box, ToolShape::Ellipse, ToolShape::Polygon}) {
+    ToolSpec t;
+    t.shape = shape;
+    t.radius_m = 0.03;
+    t.half_size_m = {0.03, 0.012};
+    t.polygon_m = {{0.0, 0.0}, {0.04, 0.0}, {0.04, 0.03}, {0.02, 0.01}, {0.0, 0.03}};  // concave
+    ToolPose pose{{0.5, 0.4}, 0.0, 0.6};
+    const ToolStamp s = make_stamp(t, pose, {1.0, 0.0}, 0);
+    const double exact = std::abs(signed_area(s.footprint));
+    const double h = 2e-4;
+    // Lattice area error is bounded by perimeter * h.
+    double perimeter = 0.0;
+    for (std::size_t i = 0; i < s.footprint.size(); ++i)
+      perimeter += (s.footprint[(i + 1) % s.footprint.size()] - s.footprint[i]).norm();
+    EXPECT_NEAR(rasterised_area(s, h), exact, perimeter * h) << to_string(shape);
+  }
+}
+
+TEST(Footprint, PoseRotatesAndTranslates) {
+  ToolSpec t;
+  t.shape = ToolShape::Box;
+  t.half_size_m = {0.02, 0.01};
+  const ToolStamp s = make_stamp(t, {{1.0, 2.0}, 0.0, std::numbers::pi / 2}, {0.0, 1.0}, 0);
+  EXPECT_TRUE(s.contains({1.0, 2.015}));   // long axis now along y
+  EXPECT_FALSE(s.contains({1.015, 2.0}));
+}
+
+TEST(ToolBottom, SphereCapIsLowestAtTheCentre) {
+  ToolSpec t;
+  t.profile = BottomProfile::SphereCap;
+  t.sphere_radius_m = 0.05;
+  const ToolStamp s = make_stamp(t, {{0.0, 0.0}, 0.1, 0.0}, {1.0, 0.0}, 0);
+  EXPECT_DOUBLE_EQ(s.bottom_z({0.0, 0.0}), 0.1);
+  EXPECT_NEAR(s.bottom_z({0.03, 0.0}), 0.1 + 0.05 - 0.04, 1e-15);
+}
+
+TEST(RimRule, ZeroInsideAndBeyondBandMoreInFront) {
+  ToolSpec t;
+  t.radius_m = 0.02;
+  t.rim.width_m = 0.01;
+  t.rim.forward_bias = 0.8;
+  const ToolStamp s = make_stamp(t, {{0.0, 0.0}, 0.0, 0.0}, {1.0, 0.0}, 0);
+  EXPECT_EQ(s.rim_weight({0.0, 0.0}), 0.0);
+  EXPECT_EQ(s.rim_weight({0.035, 0.0}), 0.0);
+  const double front = s.rim_weight({0.023, 0.0});
+  const double back = s.rim_weight({-0.023, 0.0});
+  EXPECT_GT(front, 0.0);
+  EXPECT_GT(front, 5.0 * back);
+}
+
+}  // namespace
+}  // namespace sb
