@@ -1,44 +1,184 @@
-"""Shared helpers for experiment scripts: run sandbench, read run files and summaries.
+"""Shared helpers for the experiment scripts: run sandbench (resumably, two at a time),
+read run files, fit exponents, write figures (PNG and SVG) and tables (Markdown and CSV).
 
-Runs are resumable: a run file that exists is complete (sandbench writes it under a
-temporary name and renames it when whole), so it is not run again.
+A run is skipped when its run file and summary already exist: sandbench writes the run file
+under a temporary name and renames it when whole, and the summary is written after it, so an
+existing pair is a complete run and an interrupted reproduction resumes where it stopped.
 """
+import concurrent.futures
+import csv
 import json
+import math
+import os
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "experiments" / "scenes"
+DIAGONAL_SCENE = SCENES / "flat_stroke.toml"
+DOMAIN_SIDE = 0.70710678  # flat_stroke.toml: a square whose diagonal is 1 m
 
-
-def sandbench_path(explicit=None):
-    if explicit:
-        return Path(explicit)
-    return ROOT / "build" / "release" / "harness" / "sandbench"
-
-
-def run(sandbench, scene, backend, out, overrides=(), quiet=True):
-    """Runs one back-end on a scene (skipped when `out` exists); returns the summary dict."""
-    out = Path(out)
-    summary_path = out.with_suffix(".json")
-    if out.exists() and summary_path.exists():
-        return json.loads(summary_path.read_text())
-    out.parent.mkdir(parents=True, exist_ok=True)
-    cmd = [str(sandbench), "run", str(scene), "--backend", backend, "--out", str(out), "--json"]
-    for o in overrides:
-        cmd += ["--set", o]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    if proc.returncode != 0:
-        sys.stderr.write(proc.stderr)
-        raise RuntimeError(f"sandbench failed ({proc.returncode}): {' '.join(cmd)}")
-    summary = json.loads(proc.stdout)
-    tmp = summary_path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(summary, indent=2) + "\n")
-    tmp.replace(summary_path)
-    return summary
+# Sizes per profile: "tiny" for the smoke test, "paper" for `make reproduce`,
+# "full" for `make reproduce FULL=1`.
+PROFILES = {
+    "tiny": {"fig7_n": [300, 1000], "trace": [0.1, 0.3], "fig8_n": 1000, "memory_cells": [0.02, 0.01],
+             "reference_cell": 0.005, "alpha": [0.0, 0.4, 4.0], "drift_repeat": 1},
+    "paper": {"fig7_n": [1000, 2000, 4000, 6000, 8000, 10000], "trace": [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8,
+              0.9, 1.0], "fig8_n": 10000, "memory_cells": [0.02, 0.01, 0.005, 0.0025, 0.00125],
+              "reference_cell": 0.000625, "alpha": [0.0, 0.1, 0.2, 0.4, 0.8, 1.6, 3.2, 6.4], "drift_repeat": 3},
+    "full": {"fig7_n": [1000, 2000, 4000, 6000, 8000, 10000, 30000, 100000, 300000, 1000000],
+             "trace": [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0], "fig8_n": 10000,
+             "memory_cells": [0.02, 0.01, 0.005, 0.0025, 0.00125, 0.000625], "reference_cell": 0.0003125,
+             "alpha": [0.0, 0.05, 0.1, 0.2, 0.4, 0.8, 1.6, 3.2, 6.4, 12.8], "drift_repeat": 10},
+}
 
 
 def progress(message):
     sys.stderr.write(message + "\n")
     sys.stderr.flush()
+
+
+class Context:
+    """Where an experiment reads and writes, and how it runs sandbench."""
+
+    def __init__(self, sandbench, results, profile="paper", jobs=2):
+        self.sandbench = Path(sandbench)
+        self.results = Path(results)
+        self.runs = self.results / "runs"
+        self.profile_name = profile
+        self.profile = PROFILES[profile]
+        self.jobs = jobs
+        self.results.mkdir(parents=True, exist_ok=True)
+        self._lock = threading.Lock()
+
+    def run(self, scene, backend, name, overrides=()):
+        """One sandbench run (skipped when complete); returns its summary dict."""
+        out = self.runs / f"{name}.h5"
+        summary_path = self.runs / f"{name}.json"
+        if out.exists() and summary_path.exists():
+            return json.loads(summary_path.read_text())
+        out.parent.mkdir(parents=True, exist_ok=True)
+        cmd = [str(self.sandbench), "run", str(scene), "--backend", backend, "--out", str(out), "--json"]
+        for o in overrides:
+            cmd += ["--set", o]
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise RuntimeError(f"sandbench failed ({proc.returncode}): {' '.join(cmd)}\n{proc.stderr}")
+        summary = json.loads(proc.stdout)
+        tmp = summary_path.with_name(summary_path.name + ".tmp")
+        tmp.write_text(json.dumps(summary, indent=2) + "\n")
+        tmp.replace(summary_path)
+        return summary
+
+    def run_many(self, label, jobs):
+        """Runs jobs [(scene, backend, name, overrides)] two at a time; returns summaries in order."""
+        results = [None] * len(jobs)
+        done = [0]
+
+        def one(i):
+            scene, backend, name, overrides = jobs[i]
+            results[i] = self.run(scene, backend, name, overrides)
+            with self._lock:
+                done[0] += 1
+                progress(f"  {label}: {done[0]}/{len(jobs)} {name}")
+
+        with concurrent.futures.ThreadPoolExecutor(max_workers=self.jobs) as pool:
+            for f in [pool.submit(one, i) for i in range(len(jobs))]:
+                f.result()
+        return results
+
+    def sandbench_cmd(self, *args):
+        proc = subprocess.run([str(self.sandbench), *map(str, args)], capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise RuntimeError(f"sandbench {' '.join(map(str, args))} failed:\n{proc.stderr}")
+        return proc.stdout
+
+    def figure(self, fig, name):
+        """Saves a matplotlib figure as results/NAME.png and .svg; returns the PNG's name."""
+        for ext in ("png", "svg"):
+            tmp = self.results / f"{name}.tmp.{ext}"
+            fig.savefig(tmp, dpi=120, bbox_inches="tight", metadata={"Date": None} if ext == "svg" else None)
+            tmp.replace(self.results / f"{name}.{ext}")
+        import matplotlib.pyplot as plt
+        plt.close(fig)
+        return f"{name}.png"
+
+    def table(self, name, headers, rows):
+        """Writes results/NAME.md and .csv; returns the Markdown text."""
+        def cell(v):
+            if isinstance(v, float):
+                return f"{v:.4g}" if v != 0 and (abs(v) < 1e-3 or abs(v) >= 1e5) else f"{v:.4f}".rstrip("0").rstrip(".")
+            return str(v)
+        md = "| " + " | ".join(headers) + " |\n|" + "---|" * len(headers) + "\n"
+        md += "".join("| " + " | ".join(cell(v) for v in row) + " |\n" for row in rows)
+        (self.results / f"{name}.md").write_text(md)
+        with open(self.results / f"{name}.csv", "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(headers)
+            w.writerows(rows)
+        return md
+
+
+def loglog_slope(xs, ys):
+    """Least-squares exponent b of y = a x^b over the positive points (nan if fewer than 2)."""
+    pts = [(math.log(x), math.log(y)) for x, y in zip(xs, ys) if x > 0 and y > 0]
+    if len(pts) < 2:
+        return float("nan")
+    n = len(pts)
+    mx = sum(p[0] for p in pts) / n
+    my = sum(p[1] for p in pts) / n
+    sxx = sum((p[0] - mx) ** 2 for p in pts)
+    if sxx == 0:
+        return float("nan")
+    return sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx
+
+
+def diagonal_path(fraction, margin=0.03):
+    """A stroke along the domain's diagonal, centred, `fraction` of the diagonal long, its ends
+    kept `margin` metres inside the domain so the tool and its rim stay in (so 1.0 of the
+    diagonal is really 0.915 of it; the run's own length is what the tables report)."""
+    c = DOMAIN_SIDE / 2
+    half = min(fraction * DOMAIN_SIDE / 2, c - margin)
+    a, b = c - half, c + half
+    return f"stroke.path_m=[[{a:.6f}, {a:.6f}], [{b:.6f}, {b:.6f}]]"
+
+
+def trace_length(fraction, margin=0.03):
+    """The real length of diagonal_path(fraction), as a fraction of the 1 m diagonal."""
+    return 2 * min(fraction * DOMAIN_SIDE / 2, DOMAIN_SIDE / 2 - margin) * math.sqrt(2)
+
+
+def grid_cell_for(n_nodes):
+    """Grid cell size giving about n_nodes nodes on the diagonal scene's square domain."""
+    per_side = max(2.0, math.sqrt(n_nodes))
+    return DOMAIN_SIDE / (per_side - 1)
+
+
+def read_h5(path):
+    import h5py
+    return h5py.File(path, "r")
+
+
+def env_ok():
+    try:
+        import h5py  # noqa: F401
+        import matplotlib  # noqa: F401
+        import numpy  # noqa: F401
+    except ImportError as e:
+        sys.exit(f"experiments need Debian's python3-numpy, python3-matplotlib and python3-h5py on "
+                 f"/usr/bin/python3 ({e}); run `make deps`")
+    os.environ.setdefault("MPLBACKEND", "Agg")
+
+
+def main(run):
+    """Command line of a single experiment script: runs it and prints its report section."""
+    import argparse
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--sandbench", default=str(ROOT / "build/release/harness/sandbench"))
+    ap.add_argument("--results", default=str(ROOT / "results"))
+    ap.add_argument("--profile", default="paper", choices=PROFILES)
+    a = ap.parse_args()
+    env_ok()
+    print(run(Context(a.sandbench, a.results, a.profile)))

@@ -1,0 +1,54 @@
+#!/usr/bin/python3
+"""alpha_flat: vertex count and height error against the simplification threshold (the
+trade-off of the paper's Section 5), on the dunes scene with its curved stroke."""
+import sbrun
+
+SCENE = sbrun.SCENES / "dunes.toml"
+
+
+def run(ctx):
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    alphas = ctx.profile["alpha"]
+    if 0.0 not in alphas:
+        alphas = [0.0] + list(alphas)
+    jobs = [(SCENE, "tin", f"alpha_flat/tin-a{a:g}", [f"tin.alpha_flat_deg={a}"]) for a in alphas]
+    s = ctx.run_many("alpha_flat", jobs)
+    rasters = []
+    for j in jobs:
+        with sbrun.read_h5(ctx.runs / f"{j[2]}.h5") as f:
+            rasters.append(f["/final/raster"][()])
+    ref = rasters[alphas.index(0.0)]
+    err = [float(np.sqrt(np.mean((r - ref) ** 2))) for r in rasters]
+    maxerr = [float(np.max(np.abs(r - ref))) for r in rasters]
+
+    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    xs = [max(a, 0.01) for a in alphas]
+    ax.plot(xs, [r["vertices"] for r in s], marker="o", color="C0", label="vertices after the run")
+    ax.set_xscale("log")
+    ax.set_xlabel("alpha_flat [degrees] (0 plotted at 0.01)")
+    ax.set_ylabel("vertices", color="C0")
+    ax2 = ax.twinx()
+    ax2.plot(xs, [max(e, 1e-9) for e in err], marker="s", color="C3", label="RMSE vs alpha_flat = 0")
+    ax2.set_yscale("log")
+    ax2.set_ylabel("height RMSE vs no simplification [m]", color="C3")
+    ax.set_title("alpha_flat: model size against lost detail (dunes)")
+    png = ctx.figure(fig, "alpha_flat")
+    rows = [[a, r["vertices"], r["triangles"], e, m, r["time_s.total"]] for a, r, e, m in zip(alphas, s, err, maxerr)]
+    md = ctx.table("alpha_flat", ["alpha_flat deg", "vertices", "triangles", "RMSE m", "max error m", "time s"], rows)
+    i04 = alphas.index(0.4) if 0.4 in alphas else len(alphas) // 2
+    return f"""## alpha_flat: vertices against height error
+
+![alpha_flat]({png})
+
+{md}
+- *Paper: a lower alpha_flat keeps the model too complex, a higher one flattens it and loses detail; 0.4 works
+  best.* Ours: vertices fall from {s[0]['vertices']} (no simplification) to {s[i04]['vertices']} at
+  {alphas[i04]:g} degrees with an RMSE of {err[i04]:.1e} m, and to {s[-1]['vertices']} at {alphas[-1]:g} degrees with
+  {err[-1]:.1e} m: the trade-off is reproduced; 0.4 degrees costs {err[i04] * 1000:.3f} mm of RMSE on this scene.
+"""
+
+
+if __name__ == "__main__":
+    sbrun.main(run)
