@@ -20,6 +20,16 @@ std::string to_string(TerrainKind k) {
   return "?";
 }
 
+std::string to_string(ReferenceKind k) {
+  switch (k) {
+    case ReferenceKind::None: return "none";
+    case ReferenceKind::Pile: return "pile";
+    case ReferenceKind::Crater: return "crater";
+    case ReferenceKind::Trench: return "trench";
+  }
+  return "?";
+}
+
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
@@ -312,6 +322,8 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   s.tin.conserve_volume = f.boolean("tin.conserve_volume", false);
   s.tin.contour_subdivision_m = f.number("tin.contour_subdivision_m", 0.0, closed(0.0, extent));
   s.tin.snap_m = f.number("tin.snap_m", 1e-6, closed(0.0, 1e-2));
+  s.tin.contour_gap_m = f.number("tin.contour_gap_m", 0.0, closed(0.0, extent));
+  s.tin.refine_m = f.number("tin.refine_m", 0.0, closed(0.0, extent));
 
   // [grid]
   s.grid.cell_m = f.number("grid.cell_m", 0.005, positive(extent));
@@ -321,6 +333,15 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   s.grid.neighbours = static_cast<int>(f.integer("grid.neighbours", 8, 4, 8));
   if (s.grid.neighbours != 4 && s.grid.neighbours != 8)
     Fields::fail("grid.neighbours", "= " + std::to_string(s.grid.neighbours) + " is not allowed; must be 4 or 8");
+
+  // [reference]
+  const std::string reference = f.choice("reference.kind", "none", {"none", "pile", "crater", "trench"});
+  s.reference = reference == "pile" ? ReferenceKind::Pile : reference == "crater" ? ReferenceKind::Crater
+              : reference == "trench" ? ReferenceKind::Trench : ReferenceKind::None;
+  if (s.reference == ReferenceKind::Pile && t.shape != ToolShape::Pour)
+    Fields::fail("reference.kind", "= \"pile\" needs tool.shape = \"pour\"");
+  if (s.reference == ReferenceKind::Trench && s.stroke.path_m.size() != 2)
+    Fields::fail("reference.kind", "= \"trench\" needs a straight stroke.path_m of 2 points");
 
   // [output]
   s.output.raster_m = f.number("output.raster_m", std::min(0.0025, extent / 100.0), positive(extent));

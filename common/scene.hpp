@@ -49,6 +49,9 @@ struct TinSpec {
   bool conserve_volume = false;       // compensate simplification and flip volume changes
   double contour_subdivision_m = 0.0; // outer contour subdivision step; 0: tool polygon only
   double snap_m = 1e-6;               // points closer than this to a vertex reuse it
+  double contour_gap_m = 0.0;         // outer-to-inner contour distance; 0: 5% of the tool size
+  double refine_m = 0.0;              // erosion splits edges longer than this that sand flows
+                                      // across; 0: half the tool (or pour) radius
 };
 
 enum class GridStorage { Float, Double };
@@ -57,6 +60,10 @@ struct GridSpec {
   GridStorage storage = GridStorage::Double;
   int neighbours = 8;                 // 4 or 8
 };
+
+// The analytic shape the run is measured against (common/reference.hpp).
+enum class ReferenceKind { None, Pile, Crater, Trench };
+std::string to_string(ReferenceKind k);
 
 struct OutputSpec {
   double raster_m = 0.0025;           // spacing of the common comparison raster
@@ -77,6 +84,7 @@ struct Scene {
   TinSpec tin;
   GridSpec grid;
   OutputSpec output;
+  ReferenceKind reference = ReferenceKind::None;
 };
 
 // Loads and validates a scene; throws InputError naming the offending key.

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/reference.hpp"
+
 namespace sb {
 
 Json summarize(const RunResult& run, const PreparedScene& p) {
@@ -73,6 +75,9 @@ Json summarize(const RunResult& run, const PreparedScene& p) {
   j["erosion_updates"] = updates;
   j["vertices_removed"] = removed;
   j["walk_steps"] = st.walk_steps;
+  // Accuracy against the scene's analytic reference, when it names one.
+  const Json accuracy = accuracy_metrics(p.scene, p.schedule, p.initial, run.initial_raster, run.final_raster);
+  for (const auto& [key, value] : accuracy.items()) j[key] = value;
   return j;
 }
 

@@ -1,0 +1,203 @@
+#include "common/reference.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+namespace sb {
+
+namespace {
+
+double cone_radius(double volume, double tan_angle) {
+  return std::cbrt(3.0 * volume / (std::numbers::pi * tan_angle));
+}
+
+// Least-squares slope of y against x; 0 with fewer than two distinct x.
+double fitted_slope(const std::vector<double>& x, const std::vector<double>& y) {
+  const auto n = static_cast<double>(x.size());
+  if (x.size() < 2) return 0.0;
+  double mx = 0, my = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) mx += x[i], my += y[i];
+  mx /= n;
+  my /= n;
+  double sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) sxx += (x[i] - mx) * (x[i] - mx), sxy += (x[i] - mx) * (y[i] - my);
+  return sxx > 0 ? sxy / sxx : 0.0;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// Distance from `centre` along `dir` at which the height first drops below `level`.
+double ray_crossing(const Raster& h, const Vec2& centre, const Vec2& dir, double level, double max_r) {
+  const double step = h.spacing_m / 4.0;
+  double prev = h.interpolate(centre);
+  for (double r = step; r <= max_r; r += step) {
+    const double v = h.interpolate(centre + r * dir);
+    if (v < level) return r - step * (level - v) / (prev - v);  // linear between samples
+    prev = v;
+  }
+  return max_r;
+}
+
+Raster crater_reference(const ToolStamp& s, const HeightField& initial, const Raster& lattice) {
+  // Cut volume and the rim rule's integral, by midpoint quadrature over the influence box.
+  const Aabb2 box = s.influence_bounds();
+  const int n = 1000;
+  const Vec2 d = (box.hi - box.lo) / n;
+  double cut = 0.0, rim = 0.0;
+  for (int iy = 0; iy < n; ++iy)
+    for (int ix = 0; ix < n; ++ix) {
+      const Vec2 p = box.lo + Vec2((ix + 0.5) * d.x(), (iy + 0.5) * d.y());
+      if (s.contains(p)) cut += std::max(0.0, initial(p) - s.bottom_z(p));
+      else rim += s.rim_weight(p);
+    }
+  const double scale = rim > 0.0 ? cut / rim : 0.0;  // both in units of the quadrature cell
+  Raster r = lattice;
+  for (std::size_t iy = 0; iy < r.ny; ++iy)
+    for (std::size_t ix = 0; ix < r.nx; ++ix) {
+      const Vec2 p = r.point(ix, iy);
+      const double z0 = initial(p);
+      r.at(ix, iy) = s.contains(p) ? std::min(z0, s.bottom_z(p)) : z0 + scale * s.rim_weight(p);
+    }
+  return r;
+}
+
+}  // namespace
+
+std::optional<Raster> reference_raster(const Scene& scene, const StampSchedule& schedule,
+                                       const HeightField& initial, const Raster& lattice) {
+  if (schedule.stamps.empty()) return std::nullopt;
+  const ToolStamp& first = schedule.stamps.front();
+  switch (scene.reference) {
+    case ReferenceKind::Pile: {
+      double volume = 0.0;
+      for (const ToolStamp& s : schedule.stamps) volume += s.pour_volume_m3;
+      const double t = scene.material.tan_critical();
+      const double radius = cone_radius(volume, t);
+      Raster r = lattice;
+      for (std::size_t iy = 0; iy < r.ny; ++iy)
+        for (std::size_t ix = 0; ix < r.nx; ++ix) {
+          const Vec2 p = r.point(ix, iy);
+          r.at(ix, iy) = initial(p) + std::max(0.0, (radius - (p - first.pose.xy).norm()) * t);
+        }
+      return r;
+    }
+    case ReferenceKind::Crater: return crater_reference(first, initial, lattice);
+    case ReferenceKind::Trench:
+    case ReferenceKind::None: return std::nullopt;
+  }
+  return std::nullopt;
+}
+
+PileShape measure_pile(const Raster& h, const Vec2& centre, double base_m) {
+  PileShape shape;
+  double peak = base_m;
+  for (double v : h.values) peak = std::max(peak, v);
+  shape.height_m = peak - base_m;
+  if (shape.height_m <= 0.0) return shape;
+  // Flank: height against radius where the pile is between 20% and 80% of its height.
+  std::vector<double> radius, height;
+  for (std::size_t iy = 0; iy < h.ny; ++iy)
+    for (std::size_t ix = 0; ix < h.nx; ++ix) {
+      const double above = h.at(ix, iy) - base_m;
+      if (above > 0.2 * shape.height_m && above < 0.8 * shape.height_m) {
+        radius.push_back((h.point(ix, iy) - centre).norm());
+        height.push_back(above);
+      }
+    }
+  shape.flank_angle_deg = rad_to_deg(std::atan(-fitted_slope(radius, height)));
+  // Half-height contour and foot, along 180 rays.
+  const double max_r = std::max(h.spacing_m * static_cast<double>(std::max(h.nx, h.ny)), 0.0);
+  std::vector<double> half, foot;
+  for (int k = 0; k < 180; ++k) {
+    const double a = 2.0 * std::numbers::pi * k / 180.0;
+    const Vec2 dir(std::cos(a), std::sin(a));
+    half.push_back(ray_crossing(h, centre, dir, base_m + 0.5 * shape.height_m, max_r));
+    foot.push_back(ray_crossing(h, centre, dir, base_m + 0.01 * shape.height_m, max_r));
+  }
+  double mean = 0.0, var = 0.0;
+  for (double r : half) mean += r;
+  mean /= static_cast<double>(half.size());
+  for (double r : half) var += (r - mean) * (r - mean);
+  shape.roundness = mean > 0.0 ? std::sqrt(var / static_cast<double>(half.size())) / mean : 0.0;
+  double foot_mean = 0.0;
+  for (double r : foot) foot_mean += r;
+  shape.radius_m = foot_mean / static_cast<double>(foot.size());
+  return shape;
+}
+
+TrenchShape measure_trench(const Raster& h, const Raster& initial, const Vec2& a, const Vec2& b) {
+  TrenchShape shape;
+  const double length = (b - a).norm();
+  if (length <= 0.0) return shape;
+  const Vec2 along = (b - a) / length;
+  const Vec2 across(-along.y(), along.x());
+  std::vector<double> depths, angles;
+  // Cross-sections over the middle half of the stroke, away from its ends.
+  for (int k = 0; k <= 10; ++k) {
+    const Vec2 c = a + (0.25 + 0.05 * k) * length * along;
+    const double surface = initial.interpolate(c);
+    const double bottom = h.interpolate(c);
+    const double depth = surface - bottom;
+    depths.push_back(depth);
+    if (depth <= 0.0) continue;
+    for (double side : {-1.0, 1.0}) {
+      std::vector<double> x, y;
+      const double step = h.spacing_m / 2.0;
+      for (double d = 0.0; d < 0.5 * length; d += step) {
+        const double z = h.interpolate(c + side * d * across);
+        const double rise = z - bottom;
+        if (rise > 0.2 * depth && rise < 0.8 * depth) {
+          x.push_back(d);
+          y.push_back(z);
+        }
+        if (rise >= 0.8 * depth) break;
+      }
+      if (x.size() >= 2) angles.push_back(rad_to_deg(std::atan(std::abs(fitted_slope(x, y)))));
+    }
+  }
+  shape.depth_m = median(depths);
+  shape.wall_angle_deg = angles.empty() ? 0.0 : *std::max_element(angles.begin(), angles.end());
+  return shape;
+}
+
+nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule& schedule,
+                                        const HeightField& initial, const Raster& initial_raster,
+                                        const Raster& final_raster) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
+  if (scene.reference == ReferenceKind::None || schedule.stamps.empty()) return j;
+  j["reference"] = to_string(scene.reference);
+  if (auto ref = reference_raster(scene, schedule, initial, final_raster)) {
+    const RasterDifference d = compare_rasters(final_raster, *ref);
+    j["reference.rmse_m"] = d.rmse_m;
+    j["reference.max_error_m"] = d.max_abs_m;
+  }
+  const double crit = scene.material.critical_angle_deg;
+  if (scene.reference == ReferenceKind::Pile) {
+    const Vec2 centre = schedule.stamps.front().pose.xy;
+    const PileShape p = measure_pile(final_raster, centre, initial(centre));
+    double volume = 0.0;
+    for (const ToolStamp& s : schedule.stamps) volume += s.pour_volume_m3;
+    j["pile.flank_angle_deg"] = p.flank_angle_deg;
+    j["pile.flank_angle_error_deg"] = p.flank_angle_deg - crit;
+    j["pile.roundness"] = p.roundness;
+    j["pile.radius_m"] = p.radius_m;
+    j["pile.radius_expected_m"] = cone_radius(volume, scene.material.tan_critical());
+    j["pile.height_m"] = p.height_m;
+  }
+  if (scene.reference == ReferenceKind::Trench) {
+    const auto& path = scene.stroke.path_m;
+    const TrenchShape t = measure_trench(final_raster, initial_raster, path.front(), path.back());
+    j["trench.wall_angle_deg"] = t.wall_angle_deg;
+    j["trench.wall_excess_deg"] = std::max(0.0, t.wall_angle_deg - crit);
+    j["trench.depth_m"] = t.depth_m;
+  }
+  return j;
+}
+
+}  // namespace sb
