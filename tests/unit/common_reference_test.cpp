@@ -1,0 +1,109 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "common/reference.hpp"
+
+namespace sb {
+namespace {
+
+Scene pile_scene() {
+  return parse_scene(R"(
+[domain]
+size_m = [0.3, 0.3]
+[terrain]
+height_m = 0.05
+[tool]
+shape = "pour"
+radius_m = 0.004
+volume_m3 = 1e-6
+[stroke]
+path_m = [[0.15, 0.15]]
+repeat = 20
+[reference]
+kind = "pile"
+[output]
+raster_m = 0.001
+)",
+                     "pile");
+}
+
+TEST(Reference, PileIsTheConeOfThePouredVolumeAtTheCriticalAngle) {
+  const Scene s = pile_scene();
+  const HeightField f = HeightField::from_scene(s);
+  const StampSchedule sch = make_schedule(s.tool, s.stroke, [&](const Vec2& p) { return f(p); });
+  const Raster lattice = Raster::covering(s.domain.box(), s.output.raster_m);
+  const auto cone = reference_raster(s, sch, f, lattice);
+  ASSERT_TRUE(cone);
+  // r = (3V / (pi tan 30))^(1/3) for V = 2e-5.
+  const double r = std::cbrt(3 * 2e-5 / (std::numbers::pi * std::tan(std::numbers::pi / 6)));
+  EXPECT_NEAR(cone->interpolate({0.15, 0.15}) - 0.05, r * std::tan(std::numbers::pi / 6), 1e-12);
+  double volume = 0.0;
+  for (double z : cone->values) volume += (z - 0.05) * 1e-6;
+  EXPECT_NEAR(volume, 2e-5, 2e-5 * 0.01);
+
+  const PileShape p = measure_pile(*cone, {0.15, 0.15}, 0.05);
+  EXPECT_NEAR(p.flank_angle_deg, 30.0, 0.2);
+  EXPECT_LT(p.roundness, 0.01);
+  EXPECT_NEAR(p.radius_m, r, 0.002);
+
+  const auto metrics = accuracy_metrics(s, sch, f, lattice, *cone);
+  EXPECT_EQ(metrics["reference.rmse_m"].get<double>(), 0.0);
+  EXPECT_NEAR(metrics["pile.radius_expected_m"].get<double>(), r, 1e-12);
+}
+
+TEST(Reference, RoundnessSeesADiamond) {
+  const Scene s = pile_scene();
+  Raster diamond = Raster::covering(s.domain.box(), 0.001);
+  for (std::size_t iy = 0; iy < diamond.ny; ++iy)
+    for (std::size_t ix = 0; ix < diamond.nx; ++ix) {
+      const Vec2 d = diamond.point(ix, iy) - Vec2(0.15, 0.15);
+      diamond.at(ix, iy) = 0.05 + std::max(0.0, 0.02 - 0.6 * (std::abs(d.x()) + std::abs(d.y())));
+    }
+  EXPECT_GT(measure_pile(diamond, {0.15, 0.15}, 0.05).roundness, 0.08);
+}
+
+TEST(Reference, CraterConservesTheCutVolume) {
+  const Scene s = parse_scene(R"(
+[domain]
+size_m = [0.2, 0.2]
+[terrain]
+height_m = 0.1
+[tool]
+radius_m = 0.02
+depth_m = 0.01
+[stroke]
+path_m = [[0.1, 0.1]]
+[reference]
+kind = "crater"
+[output]
+raster_m = 0.0005
+)",
+                              "crater");
+  const HeightField f = HeightField::from_scene(s);
+  const StampSchedule sch = make_schedule(s.tool, s.stroke, [&](const Vec2& p) { return f(p); });
+  const auto crater = reference_raster(s, sch, f, Raster::covering(s.domain.box(), s.output.raster_m));
+  ASSERT_TRUE(crater);
+  EXPECT_NEAR(crater->interpolate({0.1, 0.1}), 0.09, 1e-12);
+  double change = 0.0;
+  for (double z : crater->values) change += (z - 0.1) * 0.0005 * 0.0005;
+  EXPECT_NEAR(change, 0.0, 0.02 * std::numbers::pi * 0.02 * 0.02 * 0.01);
+}
+
+TEST(Reference, TrenchWallAngleAndDepth) {
+  Raster initial = Raster::covering({{0, 0}, {0.2, 0.2}}, 0.001), trench = initial;
+  const double t = std::tan(std::numbers::pi / 6);
+  for (std::size_t iy = 0; iy < initial.ny; ++iy)
+    for (std::size_t ix = 0; ix < initial.nx; ++ix) {
+      initial.at(ix, iy) = 0.1;
+      const double d = std::abs(initial.point(ix, iy).y() - 0.1);  // trench along x at y = 0.1
+      trench.at(ix, iy) = std::min(0.1, 0.09 + std::max(0.0, d - 0.01) * t);
+    }
+  const TrenchShape s = measure_trench(trench, initial, {0.02, 0.1}, {0.18, 0.1});
+  EXPECT_NEAR(s.depth_m, 0.01, 1e-9);
+  EXPECT_NEAR(s.wall_angle_deg, 30.0, 0.5);
+}
+
+}  // namespace
+}  // namespace sb
