@@ -8,7 +8,7 @@ JOBS ?= 2
 BENCH_FILTER ?= .
 FULL ?= 0
 
-.PHONY: all deps configure build test test-asan reproduce bench clean
+.PHONY: all deps configure build test test-asan reproduce bench goldens clean
 
 all: build
 
@@ -37,6 +37,11 @@ bench: build
 		echo "== $$b"; $$b --benchmark_filter='$(BENCH_FILTER)' --benchmark_repetitions=5 \
 			--benchmark_report_aggregates_only=true || exit 1; \
 	done
+
+# Rewrites tests/regression/golden/*.json from the current code: review the diff.
+goldens: build
+	@SB_UPDATE_GOLDENS=1 $(BUILD_DIR)/tests/sb_regression_tests
+	@git --no-pager diff --stat -- tests/regression/golden || true
 
 clean:
 	@rm -rf build
