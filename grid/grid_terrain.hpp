@@ -1,13 +1,83 @@
 #pragma once
-// GridTerrain: dense regular height grid (being written; see issue 2).
+// GridTerrain<Real>: a dense regular height grid (Sumner et al. 1999; Onoue & Nishita 2003;
+// Benes et al. 2006), the related-work baseline the TIN is compared with.
+//
+// Heights live on nx * ny nodes covering the domain exactly (GridLayout); the surface is
+// their bilinear interpolant. Each node stands for the area A_k = dx dy, halved on each
+// border axis, so volume() = sum A_k z_k is the interpolant's exact integral. Tool stamps
+// cut the footprint to the tool bottom and put exactly that volume on the rim band
+// (grid_stamp.hpp); erosion applies sb::erosion_transfers over an active set with an
+// 8- or 4-neighbour stencil (grid_erosion.hpp, active_set.hpp).
+//
+// Memory per node: sizeof(Real) for the height + 2 for the active-set state, i.e.
+//   double: 10 bytes/node,  float: 6 bytes/node,
+// plus 8 bytes per active node (two index lists, at their high-water mark). A 512 x 512
+// grid is 2.6 MB in double, 1.6 MB in float.
+// Volume drift after 1000 stamps with erosion (a disk tool over flat sand, measured in
+// tests/unit/grid_volume_test.cpp): double 0, float 1.4e-16 relative -- both at the
+// resolution of the volume sum itself. Float writes carry their rounding error on
+// (height_grid.hpp), which makes the sum of stored heights exact in units of one ulp;
+// without the carry float drifts by 8.4e-8 over the same stroke.
+//
+// Cost of each operation (n = nx * ny, w = nodes in a stamp's influence window,
+// v = footprint vertices, a = active nodes):
+//   construction                O(n) evaluations of the initial surface
+//   height(p)                   O(1)
+//   sample(raster)              O(raster points)
+//   stamp                       O(w * v); pour O(nodes within its radius)
+//   erode                       O(passes * a * stencil); never the whole grid
+//   simplify                    O(1), nothing to simplify on a grid
+//   volume, max_slope_deg,
+//   mesh, check                 O(n)
+//   stats                       O(1)
+#include <functional>
 #include <memory>
 
 #include "common/height_field.hpp"
 #include "common/scene.hpp"
 #include "common/terrain.hpp"
+#include "grid/active_set.hpp"
+#include "grid/height_grid.hpp"
+#include "grid/stencil.hpp"
 
 namespace sb::grid {
 
+template <class Real>
+class GridTerrain final : public Terrain {
+ public:
+  // neighbours: 4 or 8; idle_passes: idle visits before a node leaves the active set.
+  GridTerrain(const GridLayout& layout, const std::function<double(const Vec2&)>& initial, int neighbours,
+              int idle_passes);
+
+  std::string_view name() const override { return "grid"; }
+  double height(const Vec2& p) const override { return grid_.height(p); }
+  StampReport stamp(const ToolStamp& s) override;
+  ErosionReport erode(const ErosionRule& rule, const ErosionBudget& budget) override;
+  SimplifyReport simplify(const SimplifyParams&) override { return {}; }
+  double volume() const override { return grid_.volume(); }
+  ModelStats stats() const override;
+  SurfaceMesh mesh() const override;
+  void sample(Raster& out) const override;
+  IntegrityReport check() const override;
+  double max_slope_deg() const override;
+
+  // For tests and benchmarks.
+  const GridLayout& layout() const { return grid_.layout(); }
+  const HeightGrid<Real>& heights() const { return grid_; }
+  const ActiveSet& active_set() const { return active_; }
+  const Stencil& stencil() const { return stencil_; }
+
+ private:
+  HeightGrid<Real> grid_;
+  Stencil stencil_;
+  ActiveSet active_;
+};
+
+extern template class GridTerrain<float>;
+extern template class GridTerrain<double>;
+
+// The grid of the scene's [grid] section: cell size, storage, neighbours; idle passes from
+// [erosion].
 std::unique_ptr<Terrain> make_grid_terrain(const Scene& scene, const HeightField& initial);
 
 }  // namespace sb::grid

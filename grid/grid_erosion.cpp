@@ -1,0 +1,68 @@
+#include "grid/grid_erosion.hpp"
+
+#include <array>
+#include <span>
+
+namespace sb::grid {
+
+template <class Real>
+ErosionReport erode_grid(HeightGrid<Real>& grid, ActiveSet& active, const Stencil& stencil,
+                         const ErosionRule& rule, const ErosionBudget& budget) {
+  const GridLayout& layout = grid.layout();
+  ErosionReport report;
+  CompensatedSum moved;
+  std::array<ErosionNeighbour, 8> nbrs;
+  std::array<std::uint32_t, 8> nbr_node;
+  std::array<double, 8> sent;
+
+  while (report.passes < budget.max_passes && !active.empty() && report.updates < budget.max_updates) {
+    const std::span<const std::uint32_t> visiting = active.begin_pass();
+    ++report.passes;
+    for (std::size_t v = 0; v < visiting.size(); ++v) {
+      if (report.updates >= budget.max_updates) {
+        for (std::size_t rest = v; rest < visiting.size(); ++rest) active.keep(visiting[rest]);
+        break;
+      }
+      ++report.updates;
+      const std::uint32_t k = visiting[v];
+      const std::size_t ix = k % layout.nx, iy = k / layout.nx;
+      std::size_t n = 0;
+      stencil.for_each(layout, ix, iy, [&](std::size_t jx, std::size_t jy, int slot) {
+        const std::uint32_t j = layout.index(jx, jy);
+        nbrs[n] = {grid.z(j), stencil.distance_m[slot], layout.area(jx, jy)};
+        nbr_node[n] = j;
+        ++n;
+      });
+      const double z_i = grid.z(k);
+      const double area_i = layout.area(ix, iy);
+      const double total = erosion_transfers(z_i, area_i, std::span(nbrs.data(), n), rule, std::span(sent.data(), n));
+      if (total <= 0.0) {
+        active.idle(k);
+        continue;
+      }
+      // The centre loses exactly what the neighbours gain (sum of the parts, not `total`,
+      // which may differ from it in the last bit).
+      CompensatedSum given;
+      for (std::size_t m = 0; m < n; ++m) {
+        if (sent[m] <= 0.0) continue;
+        grid.set(nbr_node[m], nbrs[m].z + sent[m] / nbrs[m].area);
+        given.add(sent[m]);
+        ++report.transfers;
+      }
+      grid.set(k, z_i - given.value() / area_i);
+      moved.add(given.value());
+      active.activate(k);
+      for (std::size_t m = 0; m < n; ++m) active.activate(nbr_node[m]);
+    }
+  }
+  report.active = active.size();
+  report.volume_moved_m3 = moved.value();
+  return report;
+}
+
+template ErosionReport erode_grid<float>(HeightGrid<float>&, ActiveSet&, const Stencil&, const ErosionRule&,
+                                         const ErosionBudget&);
+template ErosionReport erode_grid<double>(HeightGrid<double>&, ActiveSet&, const Stencil&, const ErosionRule&,
+                                          const ErosionBudget&);
+
+}  // namespace sb::grid

@@ -1,0 +1,134 @@
+#include "grid/grid_stamp.hpp"
+
+#include <algorithm>
+
+namespace sb::grid {
+
+namespace {
+
+struct Cut {
+  std::uint32_t node;
+  double bottom_z;
+};
+struct Deposit {
+  std::uint32_t node;
+  double weight;
+};
+
+// Rim nodes for a stamp whose own rim band holds none: the band is widened by a growing
+// multiple of the cell diagonal and weighted by taper only (the directional factor may be
+// zero on the only side the domain leaves). Empty only when no node lies outside the
+// footprint at all.
+std::vector<Deposit> widened_rim(const GridLayout& layout, const ToolStamp& s) {
+  const Aabb2 footprint_box = bounds(s.footprint);
+  const Aabb2 grid_box = layout.box();
+  std::vector<Deposit> rim;
+  for (double extra = layout.diagonal();; extra *= 2.0) {
+    const double width = std::max(0.0, s.rim.width_m) + extra;
+    const Aabb2 window = footprint_box.expanded(width);
+    const NodeRange r = layout.nodes_in(window);
+    bool any_outside = false;
+    for (std::size_t iy = r.y0; !r.empty && iy <= r.y1; ++iy) {
+      for (std::size_t ix = r.x0; ix <= r.x1; ++ix) {
+        const Vec2 p = layout.position(ix, iy);
+        if (s.contains(p)) continue;
+        any_outside = true;
+        const double d = distance_to_boundary(s.footprint, p);
+        if (d < width) rim.push_back({layout.index(ix, iy), 1.0 - d / width});
+      }
+    }
+    if (!rim.empty()) return rim;
+    const bool covers_grid = window.contains(grid_box.lo) && window.contains(grid_box.hi);
+    if (covers_grid && !any_outside) return rim;
+  }
+}
+
+template <class Real>
+StampReport cut_and_push(HeightGrid<Real>& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed) {
+  const GridLayout& layout = grid.layout();
+  StampReport report;
+  if (s.footprint.size() < 3) return report;
+  const NodeRange r = layout.nodes_in(s.influence_bounds());
+  if (r.empty) return report;
+
+  std::vector<Cut> cuts;
+  std::vector<Deposit> rim;
+  for (std::size_t iy = r.y0; iy <= r.y1; ++iy) {
+    for (std::size_t ix = r.x0; ix <= r.x1; ++ix) {
+      const Vec2 p = layout.position(ix, iy);
+      const std::uint32_t k = layout.index(ix, iy);
+      if (s.contains(p)) {
+        const double bottom = s.bottom_z(p);
+        if (grid.z(k) > bottom) cuts.push_back({k, bottom});
+      } else if (const double w = s.rim_weight(p); w > 0.0) {
+        rim.push_back({k, w});
+      }
+    }
+  }
+  if (cuts.empty()) return report;
+  if (rim.empty()) rim = widened_rim(layout, s);
+  // No node outside the footprint (a tool larger than the domain): cutting would lose
+  // the volume, so the stamp does nothing.
+  if (rim.empty()) return report;
+
+  CompensatedSum removed, rim_weight;
+  for (const Cut& c : cuts) removed.add(layout.area(c.node) * (grid.z(c.node) - c.bottom_z));
+  for (const Deposit& d : rim) rim_weight.add(layout.area(d.node) * d.weight);
+  const double volume = removed.value();
+  const double per_weight = volume / rim_weight.value();
+
+  for (const Cut& c : cuts) {
+    grid.set(c.node, c.bottom_z);
+    changed.push_back(c.node);
+  }
+  CompensatedSum deposited;
+  for (const Deposit& d : rim) {
+    const double dz = per_weight * d.weight;
+    grid.set(d.node, grid.z(d.node) + dz);
+    deposited.add(layout.area(d.node) * dz);
+    changed.push_back(d.node);
+  }
+  report.volume_removed_m3 = volume;
+  report.volume_deposited_m3 = deposited.value();
+  report.elements_touched = cuts.size() + rim.size();
+  return report;
+}
+
+template <class Real>
+StampReport pour(HeightGrid<Real>& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed) {
+  const GridLayout& layout = grid.layout();
+  std::vector<std::uint32_t> nodes;
+  const NodeRange r = layout.nodes_in(s.influence_bounds());
+  const double r2 = s.pour_radius_m * s.pour_radius_m;
+  for (std::size_t iy = r.y0; !r.empty && iy <= r.y1; ++iy)
+    for (std::size_t ix = r.x0; ix <= r.x1; ++ix)
+      if ((layout.position(ix, iy) - s.pose.xy).squaredNorm() <= r2) nodes.push_back(layout.index(ix, iy));
+  // A pour narrower than a cell (or off the grid) still lands somewhere.
+  if (nodes.empty()) nodes.push_back(layout.nearest(s.pose.xy));
+
+  CompensatedSum area;
+  for (std::uint32_t k : nodes) area.add(layout.area(k));
+  const double dz = s.pour_volume_m3 / area.value();
+  CompensatedSum deposited;
+  for (std::uint32_t k : nodes) {
+    grid.set(k, grid.z(k) + dz);
+    deposited.add(layout.area(k) * dz);
+    changed.push_back(k);
+  }
+  StampReport report;
+  report.volume_deposited_m3 = deposited.value();
+  report.elements_touched = nodes.size();
+  return report;
+}
+
+}  // namespace
+
+template <class Real>
+StampReport stamp_grid(HeightGrid<Real>& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed) {
+  return s.is_pour() ? pour(grid, s, changed) : cut_and_push(grid, s, changed);
+}
+
+template StampReport stamp_grid<float>(HeightGrid<float>&, const ToolStamp&, std::vector<std::uint32_t>&);
+template StampReport stamp_grid<double>(HeightGrid<double>&, const ToolStamp&, std::vector<std::uint32_t>&);
+
+}  // namespace sb::grid

@@ -1,0 +1,23 @@
+#pragma once
+// Tool stamps on a height grid (common/tool.hpp's rule): cut the nodes inside the footprint
+// down to the tool bottom and put exactly that volume on the rim band; or pour.
+//
+// Cost: O(nodes in s.influence_bounds() * footprint vertices) -- every node of the window
+// is tested against the footprint and the rim nodes get their distance to its boundary.
+// Only when the rim band holds no node (narrower than a cell, clipped by the domain) is
+// the window widened, doubling the extra width each time: O(log(domain / cell)) rescans
+// at worst. A pour is O(nodes within the pour radius).
+#include <cstdint>
+#include <vector>
+
+#include "common/terrain.hpp"
+#include "grid/height_grid.hpp"
+
+namespace sb::grid {
+
+// Applies one stamp. Appends every node whose height changed to `changed`.
+// Volume: removed == deposited (to rounding); a pour adds s.pour_volume_m3.
+template <class Real>
+StampReport stamp_grid(HeightGrid<Real>& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed);
+
+}  // namespace sb::grid
