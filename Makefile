@@ -8,7 +8,9 @@ JOBS ?= 2
 BENCH_FILTER ?= .
 FULL ?= 0
 
-.PHONY: all deps configure build test test-asan reproduce bench goldens clean
+FUZZ_SECONDS ?= 60
+
+.PHONY: all deps configure build test test-asan reproduce bench goldens fuzz clean
 
 all: build
 
@@ -42,6 +44,19 @@ bench: build
 goldens: build
 	@SB_UPDATE_GOLDENS=1 $(BUILD_DIR)/tests/sb_regression_tests
 	@git --no-pager diff --stat -- tests/regression/golden || true
+
+# libFuzzer targets (clang, AddressSanitizer) for FUZZ_SECONDS each; not part of CI.
+# Corpora are kept in build/fuzz/corpus-*; a crash leaves its input in build/fuzz/.
+fuzz:
+	@bash .ci/deps.sh fuzz
+	@CC=clang CXX=clang++ cmake -S . -B build/fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSANDBENCH_BUILD_FUZZ=ON \
+		-DSANDBENCH_BUILD_TESTS=OFF -DSANDBENCH_BUILD_BENCH=OFF \
+		-DCMAKE_CXX_FLAGS="-fsanitize=fuzzer-no-link,address,undefined -fno-omit-frame-pointer" >/dev/null
+	@cmake --build build/fuzz -j$(JOBS) --target scene_fuzz stamp_fuzz
+	@for t in scene_fuzz stamp_fuzz; do \
+		mkdir -p build/fuzz/corpus-$$t; \
+		(cd build/fuzz && ./tests/fuzz/$$t -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 corpus-$$t) || exit 1; \
+	done
 
 clean:
 	@rm -rf build

@@ -10,7 +10,13 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   python3-numpy python3-matplotlib python3-h5py
+  libglfw3-dev libimgui-dev xvfb xauth
 )
+
+# `deps.sh fuzz` adds clang and its libFuzzer runtime (for `make fuzz` only).
+if [[ "${1:-}" == "fuzz" ]]; then
+  packages+=(clang libclang-rt-14-dev)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
