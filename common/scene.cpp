@@ -347,6 +347,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   s.output.raster_m = f.number("output.raster_m", std::min(0.0025, extent / 100.0), positive(extent));
   const double samples = (s.domain.size_m.x() / s.output.raster_m + 1) * (s.domain.size_m.y() / s.output.raster_m + 1);
   if (samples > 1e8) Fields::fail("output.raster_m", "gives more than 1e8 raster samples for this domain");
+  s.output.energy = f.boolean("output.energy", false);
 }
 
 }  // namespace

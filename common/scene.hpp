@@ -67,6 +67,9 @@ std::string to_string(ReferenceKind k);
 
 struct OutputSpec {
   double raster_m = 0.0025;           // spacing of the common comparison raster
+  // Record the sand's potential energy after every step (costs one raster sample per step);
+  // used to detect oscillating erosion, whose energy rises.
+  bool energy = false;
 };
 
 struct Scene {

@@ -1,0 +1,209 @@
+#pragma once
+// Private to tin/*.cpp: the CGAL types and the TinTerrain class that implements Terrain.
+// Including this header costs ~20 s of compile time per translation unit (it is the
+// precompiled header of sb_tin), so only the handful of tin/*.cpp files include it.
+#include <CGAL/Constrained_Delaunay_triangulation_2.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Projection_traits_xy_3.h>
+#include <CGAL/Triangulation_face_base_with_info_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+
+#include <cstdint>
+#include <functional>
+#include <unordered_map>
+#include <vector>
+
+#include "common/height_field.hpp"
+#include "common/scene.hpp"
+#include "common/terrain.hpp"
+
+namespace sb::tin::detail {
+
+inline constexpr std::uint32_t kNoSlot = 0xffffffffu;
+
+// Per-vertex bookkeeping, 16 bytes.
+struct VertexInfo {
+  std::uint32_t erosion_slot = kNoSlot;   // index in L_e, or kNoSlot
+  std::uint32_t simplify_slot = kNoSlot;  // index in L_r, or kNoSlot
+  std::uint32_t mark = 0;                 // traversal epoch (see TinTerrain::next_vertex_epoch)
+  std::uint16_t idle = 0;                 // erosion visits without a transfer
+  std::uint8_t border = 0;                // on the domain boundary: never removed
+  std::uint8_t unused = 0;
+};
+
+// A face's traversal epoch (or, while building, its sample bucket + 1). A class so that new
+// faces start at 0: CGAL default-initializes face info, which leaves a bare integer undefined.
+struct FaceMark {
+  std::uint32_t value = 0;
+  FaceMark& operator=(std::uint32_t v) {
+    value = v;
+    return *this;
+  }
+  operator std::uint32_t() const { return value; }
+};
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Traits = CGAL::Projection_traits_xy_3<Kernel>;
+using VertexBase = CGAL::Triangulation_vertex_base_with_info_2<VertexInfo, Traits>;
+// The face's mark goes last, into the padding after the constraint flags: 56 bytes a face
+// (the other order pads to 64).
+using FaceBase = CGAL::Triangulation_face_base_with_info_2<FaceMark, Traits,
+                                                           CGAL::Constrained_triangulation_face_base_2<Traits>>;
+using Tds = CGAL::Triangulation_data_structure_2<VertexBase, FaceBase>;
+// Constraints may pass through existing vertices but never cross each other: the stamp drops
+// every old constraint near a new one first, so no intersection point is ever constructed
+// (the input that trips CGAL issues 2999, 3263 and 5439 cannot arise).
+using Cdt = CGAL::Constrained_Delaunay_triangulation_2<
+    Traits, Tds, CGAL::No_constraint_intersection_requiring_constructions_tag>;
+using Point = Kernel::Point_3;
+using VertexHandle = Cdt::Vertex_handle;
+using FaceHandle = Cdt::Face_handle;
+
+// An undirected edge by its two vertices (ordered by address).
+struct EdgeKey {
+  const void* a;
+  const void* b;
+  EdgeKey(VertexHandle u, VertexHandle v) {
+    const void* pu = &*u;
+    const void* pv = &*v;
+    a = pu < pv ? pu : pv;
+    b = pu < pv ? pv : pu;
+  }
+  bool operator==(const EdgeKey& o) const { return a == o.a && b == o.b; }
+};
+struct EdgeKeyHash {
+  std::size_t operator()(const EdgeKey& k) const noexcept {
+    const auto x = reinterpret_cast<std::uintptr_t>(k.a), y = reinterpret_cast<std::uintptr_t>(k.b);
+    return static_cast<std::size_t>((x * 0x9E3779B97F4A7C15ull) ^ (y + 0x632BE59BD9B4E019ull + (x << 6) + (x >> 2)));
+  }
+};
+
+struct Location {
+  FaceHandle face;
+  Cdt::Locate_type type = Cdt::FACE;
+  int index = 0;  // vertex index for VERTEX, opposite vertex of the edge for EDGE
+};
+
+// The faces an operation may change, captured before it so that the volume change of the
+// retriangulation can be measured after it. The region is every face whose circumcircle
+// meets `box`; faces outside it are untouched by insertions, constraint changes and vertex
+// removals inside `box` (the constrained Delaunay triangulation only changes where
+// visibility or circumcircles change), so the region before and after covers the same area.
+struct OuterFace {
+  FaceHandle face;
+  const void* vertices[3];  // to tell the face from a new one in its recycled slot
+  int toward = 0;           // index of the neighbour inside the region
+};
+struct Capture {
+  std::vector<OuterFace> outer;   // finite faces just outside the region, sorted by address
+  double volume = 0.0;            // integral of z over the region before
+  double area = 0.0;
+  std::size_t faces = 0;
+};
+struct CaptureResult {
+  double volume_before = 0.0, volume_after = 0.0;
+  double area_before = 0.0, area_after = 0.0;
+  std::size_t faces_after = 0;
+  double delta() const { return volume_after - volume_before; }
+};
+
+class TinTerrain final : public Terrain {
+ public:
+  explicit TinTerrain(const Scene& scene);
+  void build_from_field(const HeightField& field);                // build.cpp
+  void build_from_points(const std::vector<Vec3>& points);        // build.cpp
+
+  std::string_view name() const override { return "tin"; }
+  double height(const Vec2& p) const override;                             // mesh_ops.cpp
+  StampReport stamp(const ToolStamp& s) override;                          // stamp.cpp
+  ErosionReport erode(const ErosionRule& rule, const ErosionBudget& budget) override;  // erosion.cpp
+  SimplifyReport simplify(const SimplifyParams& params) override;          // simplify.cpp
+  double volume() const override;                                          // stats_check.cpp
+  ModelStats stats() const override;
+  SurfaceMesh mesh() const override;
+  void sample(Raster& out) const override;
+  IntegrityReport check() const override;
+  double max_slope_deg() const override;
+
+ private:
+  // mesh_ops.cpp: location, insertion, removal, constraints, lists, captures.
+  FaceHandle start_face() const;
+  Location locate(const Vec2& p) const;
+  double interpolate(FaceHandle f, const Vec2& p) const;
+  Vec2 clamp_to_domain(const Vec2& p) const;
+  bool on_border(const Vec2& p) const;
+  // Inserts a vertex at p (snapped onto the border and onto vertices within tin.snap_m) with
+  // height z, keeping generation records of a constrained edge it splits. `inserted` tells
+  // whether a new vertex was made.
+  VertexHandle insert_point(const Vec2& p, double z, bool* inserted = nullptr);
+  // Removes an unconstrained, non-border vertex, keeping the lists and the hint valid.
+  void remove_vertex(VertexHandle v);
+  void constrain(VertexHandle a, VertexHandle b, std::uint32_t generation);
+  void unconstrain(VertexHandle a, VertexHandle b);
+  bool has_constraints(VertexHandle v) const;
+  double vertex_area(VertexHandle v) const;
+  void set_z(VertexHandle v, double z);
+  Capture begin_capture(const Aabb2& box);
+  CaptureResult end_capture(Capture& c, std::vector<VertexHandle>* region_vertices = nullptr);
+  // Vertices inside `box` (a traversal of the faces overlapping it).
+  void collect_vertices(const Aabb2& box, std::vector<VertexHandle>& out);
+  void touch(VertexHandle v);                   // joins L_e (idle count reset)
+  void touch_with_neighbours(VertexHandle v);   // v and its neighbours join L_e
+  void drop_from_erosion(VertexHandle v);
+  void add_to_simplify(VertexHandle v);
+  void drop_from_simplify(VertexHandle v);
+  std::uint32_t next_face_epoch();
+  std::uint32_t next_vertex_epoch();
+
+  // stamp.cpp
+  StampReport pour(const ToolStamp& s);
+  // erosion.cpp: splits edge (a, b) at its middle (volume change measured, and compensated
+  // under tin.conserve_volume); returns the vertex there.
+  VertexHandle split_edge(VertexHandle a, VertexHandle b, bool* inserted);
+  // Splits v's edges longer than refine_m_ until none is; returns the number of splits.
+  std::size_t refine_around(VertexHandle v);
+  // build.cpp
+  void insert_corners(const std::function<double(const Vec2&)>& z);
+  void finish_build();
+
+  DomainSpec domain_;
+  Aabb2 box_;
+  TinSpec spec_;
+  int idle_passes_ = 2;
+  double refine_m_ = 0.0;     // edge length above which erosion splits an edge it flows across
+  double tool_size_m_ = 0.0;  // characteristic radius of the scene's tool
+  TerrainKind kind_ = TerrainKind::Flat;
+  double base_height_m_ = 0.0;
+
+  Cdt cdt_;
+  std::unordered_map<EdgeKey, std::uint32_t, EdgeKeyHash> generations_;  // constrained edges
+  std::vector<VertexHandle> erosion_list_;   // L_e
+  std::vector<VertexHandle> simplify_list_;  // L_r
+
+  mutable VertexHandle hint_;
+  mutable std::uint64_t walk_steps_ = 0;
+  mutable std::uint32_t rng_ = 0x9E3779B9u;
+  std::uint32_t face_epoch_ = 0;
+  std::uint32_t vertex_epoch_ = 0;
+  std::size_t capture_mismatches_ = 0;  // regions whose area changed: a broken assumption
+  double retriangulation_volume_m3_ = 0.0;  // volume changes measured by captures, summed
+
+  // Scratch reused across calls (counted in stats().bytes).
+  std::vector<ErosionNeighbour> nbr_scratch_;
+  std::vector<double> transfer_scratch_;
+  std::vector<VertexHandle> vertex_scratch_;
+  std::vector<FaceHandle> face_scratch_;
+};
+
+// Area of a finite face projected on the xy plane (positive: faces are counter-clockwise).
+inline double face_area(FaceHandle f) {
+  const Point &a = f->vertex(0)->point(), &b = f->vertex(1)->point(), &c = f->vertex(2)->point();
+  return 0.5 * ((b.x() - a.x()) * (c.y() - a.y()) - (b.y() - a.y()) * (c.x() - a.x()));
+}
+inline double face_volume(FaceHandle f) {
+  return face_area(f) * (f->vertex(0)->point().z() + f->vertex(1)->point().z() + f->vertex(2)->point().z()) / 3.0;
+}
+inline Vec2 xy(const Point& p) { return {p.x(), p.y()}; }
+inline Vec2 xy(VertexHandle v) { return xy(v->point()); }
+
+}  // namespace sb::tin::detail

@@ -1,0 +1,131 @@
+// Erosion (the paper's step 2a-2e): the common rule (sb::erosion_transfers) over the TIN's
+// edges with barycentric vertex areas, so every transfer conserves volume exactly. Vertices
+// that exchange sand first get edges no longer than refine_m_ (long edges are split at their
+// middle): a pile poured on a coarse TIN can only spread if the mesh refines where the sand
+// goes, and sand on a vertex with far-reaching triangles would be spread thinly over them.
+#include <cmath>
+
+#include "common/input_error.hpp"
+#include "tin/detail/tin_impl.hpp"
+
+namespace sb::tin::detail {
+
+namespace {
+
+// Neighbours of v with their heights, distances and areas; returns v's own area.
+double gather(const Cdt& cdt, VertexHandle v, std::vector<VertexHandle>& handles,
+              std::vector<ErosionNeighbour>& nbrs) {
+  handles.clear();
+  nbrs.clear();
+  double area = 0.0;
+  auto fc = cdt.incident_faces(v), fdone = fc;
+  do {
+    if (!cdt.is_infinite(fc)) area += face_area(fc);
+  } while (++fc != fdone);
+  auto c = cdt.incident_vertices(v), done = c;
+  do {
+    if (cdt.is_infinite(c)) continue;
+    const VertexHandle w = c;
+    double aw = 0.0;
+    auto wc = cdt.incident_faces(w), wdone = wc;
+    do {
+      if (!cdt.is_infinite(wc)) aw += face_area(wc);
+    } while (++wc != wdone);
+    handles.push_back(w);
+    nbrs.push_back({w->point().z(), (xy(w) - xy(v)).norm(), aw / 3.0});
+  } while (++c != done);
+  return area / 3.0;
+}
+
+}  // namespace
+
+VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* inserted) {
+  const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
+  const Vec2 m = 0.5 * (xy(a) + xy(b));
+  Capture capture = begin_capture(Aabb2{m, m}.expanded(4.0 * spec_.snap_m + 1e-9 * extent));
+  const VertexHandle v = insert_point(m, height(m), inserted);
+  const CaptureResult measured = end_capture(capture);
+  if (!*inserted) return v;
+  // The split itself keeps the surface; the Delaunay flips after it may not.
+  if (spec_.conserve_volume && measured.delta() != 0.0) {
+    const double area = vertex_area(v);
+    if (area > 0.0) set_z(v, v->point().z() - measured.delta() / area);
+  }
+  touch_with_neighbours(v);
+  return v;
+}
+
+std::size_t TinTerrain::refine_around(VertexHandle v) {
+  std::size_t splits = 0;
+  for (int guard = 0; guard < 64; ++guard) {
+    VertexHandle far;
+    double longest = refine_m_;
+    auto c = cdt_.incident_vertices(v), done = c;
+    do {
+      if (cdt_.is_infinite(c)) continue;
+      const double d = (xy(c) - xy(v)).norm();
+      if (d > longest) {
+        longest = d;
+        far = c;
+      }
+    } while (++c != done);
+    if (far == VertexHandle()) break;
+    bool inserted = false;
+    split_edge(v, far, &inserted);
+    if (!inserted) break;
+    ++splits;
+  }
+  return splits;
+}
+
+ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& budget) {
+  if (!std::isfinite(rule.tan_critical) || !std::isfinite(rule.tan_settle) || !std::isfinite(rule.fraction) ||
+      rule.tan_critical < 0.0 || rule.fraction < 0.0)
+    throw InputError("erosion: the rule's slopes and fraction must be finite and non-negative");
+  ErosionReport report;
+  std::vector<VertexHandle> work;
+  for (int pass = 0; pass < budget.max_passes && !erosion_list_.empty() && report.updates < budget.max_updates;
+       ++pass) {
+    ++report.passes;
+    work.assign(erosion_list_.begin(), erosion_list_.end());
+    for (VertexHandle v : work) {
+      if (report.updates >= budget.max_updates) break;
+      if (v->info().erosion_slot == kNoSlot) continue;
+      ++report.updates;
+      double area = gather(cdt_, v, vertex_scratch_, nbr_scratch_);
+      transfer_scratch_.resize(nbr_scratch_.size());
+      double total = erosion_transfers(v->point().z(), area, nbr_scratch_, rule, transfer_scratch_);
+      // Sand moving between vertices with long edges would spread over far-reaching
+      // triangles: refine the stars of the giver and the receivers first, then recompute.
+      for (int round = 0; round < 3 && total > 0.0; ++round) {
+        std::size_t splits = refine_around(v);
+        for (std::size_t k = 0; k < nbr_scratch_.size(); ++k)
+          if (transfer_scratch_[k] > 0.0) splits += refine_around(vertex_scratch_[k]);
+        if (splits == 0) break;
+                area = gather(cdt_, v, vertex_scratch_, nbr_scratch_);
+        transfer_scratch_.resize(nbr_scratch_.size());
+        total = erosion_transfers(v->point().z(), area, nbr_scratch_, rule, transfer_scratch_);
+      }
+      if (total > 0.0 && area > 0.0) {
+        set_z(v, v->point().z() - total / area);
+        touch_with_neighbours(v);
+        add_to_simplify(v);
+        for (std::size_t k = 0; k < nbr_scratch_.size(); ++k) {
+          if (transfer_scratch_[k] <= 0.0 || nbr_scratch_[k].area <= 0.0) continue;
+          const VertexHandle w = vertex_scratch_[k];
+          set_z(w, w->point().z() + transfer_scratch_[k] / nbr_scratch_[k].area);
+          touch_with_neighbours(w);
+          add_to_simplify(w);
+          ++report.transfers;
+        }
+        report.volume_moved_m3 += total;
+      } else if (++v->info().idle >= idle_passes_) {
+        drop_from_erosion(v);
+      }
+    }
+  }
+  report.active = erosion_list_.size();
+  return report;
+}
+
+}  // namespace sb::tin::detail

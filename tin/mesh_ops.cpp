@@ -1,0 +1,452 @@
+// The TIN's primitive operations: point location by walking, interpolation, insertion with
+// snapping, vertex removal, constraints with their generation records, the erosion and
+// simplification lists, and region captures for measuring retriangulation volume changes.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "common/input_error.hpp"
+#include "tin/detail/tin_impl.hpp"
+
+namespace sb::tin::detail {
+
+FaceHandle TinTerrain::start_face() const {
+  FaceHandle f = hint_ != VertexHandle() ? hint_->face() : FaceHandle(cdt_.finite_faces_begin());
+  if (cdt_.is_infinite(f)) f = f->neighbor(f->index(cdt_.infinite_vertex()));
+  return f;
+}
+
+// A remembering stochastic visibility walk (Devillers, Pion, Teillaud 2002) from the hint:
+// cross an edge that separates the face from p, trying the edges in a random order and never
+// straight back. O(1) steps when the hint is near p, which is how the model is queried.
+Location TinTerrain::locate(const Vec2& p) const {
+  const Point q(p.x(), p.y(), 0.0);
+  const auto orient = cdt_.geom_traits().orientation_2_object();
+  FaceHandle f = start_face();
+  FaceHandle came_from;
+  // A walk can only cycle in a non-Delaunay triangulation, and the random order breaks such
+  // cycles with probability 1; the cap is a guard, never expected to be reached.
+  const std::uint64_t cap = 64 + 4 * static_cast<std::uint64_t>(cdt_.number_of_faces());
+  std::uint64_t steps = 0;
+  bool walked_out = false;
+  for (;;) {
+    ++steps;
+    rng_ = rng_ * 1664525u + 1013904223u;
+    const int first = static_cast<int>((rng_ >> 16) % 3);
+    FaceHandle next;
+    for (int k = 0; k < 3; ++k) {
+      const int i = (first + k) % 3;
+      const FaceHandle n = f->neighbor(i);
+      if (n == came_from) continue;
+      if (orient(f->vertex(Cdt::ccw(i))->point(), f->vertex(Cdt::cw(i))->point(), q) == CGAL::RIGHT_TURN) {
+        if (cdt_.is_infinite(n)) walked_out = true;
+        else next = n;
+        break;
+      }
+    }
+    if (next == FaceHandle() || steps > cap) break;
+    came_from = f;
+    f = next;
+  }
+  walk_steps_ += steps;
+
+  Location loc;
+  loc.face = f;
+  int collinear[3];
+  int n_collinear = 0;
+  bool inside = !walked_out && steps <= cap;
+  for (int i = 0; i < 3 && inside; ++i) {
+    const auto o = orient(f->vertex(Cdt::ccw(i))->point(), f->vertex(Cdt::cw(i))->point(), q);
+    if (o == CGAL::RIGHT_TURN) inside = false;
+    if (o == CGAL::COLLINEAR) collinear[n_collinear++] = i;
+  }
+  if (!inside) {
+    // Off the hull (callers clamp to the domain, so only by a guard) or a capped walk.
+    int li = 0;
+    Cdt::Locate_type lt;
+    loc.face = cdt_.locate(q, lt, li, f);
+    loc.type = lt;
+    loc.index = li;
+    if (lt == Cdt::OUTSIDE_CONVEX_HULL || lt == Cdt::OUTSIDE_AFFINE_HULL || cdt_.is_infinite(loc.face)) {
+      FaceHandle g = loc.face;
+      if (cdt_.is_infinite(g)) g = g->neighbor(g->index(cdt_.infinite_vertex()));
+      loc.face = g;
+      loc.type = Cdt::FACE;
+      loc.index = 0;
+    }
+    return loc;
+  }
+  if (n_collinear == 0) {
+    loc.type = Cdt::FACE;
+  } else if (n_collinear == 1) {
+    loc.type = Cdt::EDGE;
+    loc.index = collinear[0];
+  } else {
+    loc.type = Cdt::VERTEX;
+    loc.index = 3 - collinear[0] - collinear[1];
+  }
+  return loc;
+}
+
+double TinTerrain::interpolate(FaceHandle f, const Vec2& p) const {
+  const Point &a = f->vertex(0)->point(), &b = f->vertex(1)->point(), &c = f->vertex(2)->point();
+  const double bx = b.x() - a.x(), by = b.y() - a.y(), cx = c.x() - a.x(), cy = c.y() - a.y();
+  const double px = p.x() - a.x(), py = p.y() - a.y();
+  const double det = bx * cy - by * cx;
+  if (!(std::abs(det) > 0.0)) return (a.z() + b.z() + c.z()) / 3.0;
+  const double wb = (px * cy - py * cx) / det;
+  const double wc = (bx * py - by * px) / det;
+  return a.z() + wb * (b.z() - a.z()) + wc * (c.z() - a.z());
+}
+
+Vec2 TinTerrain::clamp_to_domain(const Vec2& p) const {
+  return {std::clamp(p.x(), box_.lo.x(), box_.hi.x()), std::clamp(p.y(), box_.lo.y(), box_.hi.y())};
+}
+
+bool TinTerrain::on_border(const Vec2& p) const {
+  return p.x() == box_.lo.x() || p.x() == box_.hi.x() || p.y() == box_.lo.y() || p.y() == box_.hi.y();
+}
+
+double TinTerrain::height(const Vec2& p) const {
+  if (!std::isfinite(p.x()) || !std::isfinite(p.y()))
+    throw InputError("tin: height query at a non-finite point");
+  const Vec2 q = clamp_to_domain(p);
+  const Location loc = locate(q);
+  hint_ = loc.face->vertex(0);
+  if (loc.type == Cdt::VERTEX) return loc.face->vertex(loc.index)->point().z();
+  return interpolate(loc.face, q);
+}
+
+VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted) {
+  if (inserted) *inserted = false;
+  if (!std::isfinite(p_in.x()) || !std::isfinite(p_in.y()) || !std::isfinite(z))
+    throw InputError("tin: a vertex must have finite coordinates");
+  Vec2 p = clamp_to_domain(p_in);
+  const double snap = spec_.snap_m;
+  if (p.x() - box_.lo.x() <= snap) p.x() = box_.lo.x();
+  else if (box_.hi.x() - p.x() <= snap) p.x() = box_.hi.x();
+  if (p.y() - box_.lo.y() <= snap) p.y() = box_.lo.y();
+  else if (box_.hi.y() - p.y() <= snap) p.y() = box_.hi.y();
+
+  const Location loc = locate(p);
+  if (loc.type == Cdt::VERTEX) {
+    hint_ = loc.face->vertex(loc.index);
+    return hint_;
+  }
+  if (snap > 0.0) {
+    VertexHandle nearest;
+    double best = snap * snap;
+    auto consider = [&](VertexHandle v) {
+      if (cdt_.is_infinite(v)) return;
+      const double d2 = (xy(v) - p).squaredNorm();
+      if (d2 <= best) {
+        best = d2;
+        nearest = v;
+      }
+    };
+    for (int i = 0; i < 3; ++i) {
+      consider(loc.face->vertex(i));
+      consider(loc.face->neighbor(i)->vertex(cdt_.mirror_index(loc.face, i)));
+    }
+    if (nearest != VertexHandle()) {
+      hint_ = nearest;
+      return nearest;
+    }
+  }
+
+  // A point on a constrained edge splits it; both halves keep the edge's generation.
+  bool splits_constraint = false;
+  std::uint32_t generation = 0;
+  VertexHandle e1, e2;
+  if (loc.type == Cdt::EDGE && loc.face->is_constrained(loc.index)) {
+    splits_constraint = true;
+    e1 = loc.face->vertex(Cdt::ccw(loc.index));
+    e2 = loc.face->vertex(Cdt::cw(loc.index));
+    const auto it = generations_.find(EdgeKey(e1, e2));
+    if (it != generations_.end()) {
+      generation = it->second;
+      generations_.erase(it);
+    }
+  }
+  const VertexHandle v = cdt_.insert(Point(p.x(), p.y(), z), loc.type, loc.face, loc.index);
+  v->info() = VertexInfo{};
+  v->info().border = on_border(p) ? 1 : 0;
+  if (splits_constraint) {
+    generations_[EdgeKey(e1, v)] = generation;
+    generations_[EdgeKey(v, e2)] = generation;
+  }
+  hint_ = v;
+  if (inserted) *inserted = true;
+  return v;
+}
+
+void TinTerrain::remove_vertex(VertexHandle v) {
+  drop_from_erosion(v);
+  drop_from_simplify(v);
+  if (hint_ == v) {
+    hint_ = VertexHandle();
+    auto c = cdt_.incident_vertices(v), done = c;
+    do {
+      if (!cdt_.is_infinite(c)) {
+        hint_ = c;
+        break;
+      }
+    } while (++c != done);
+  }
+  cdt_.remove(v);
+}
+
+void TinTerrain::constrain(VertexHandle a, VertexHandle b, std::uint32_t generation) {
+  if (a == b) return;
+  cdt_.insert_constraint(a, b);
+  // The constraint is split where it passes through vertices: record every piece.
+  const auto orient = cdt_.geom_traits().orientation_2_object();
+  VertexHandle cur = a, prev;
+  for (std::size_t guard = 0; cur != b && guard < cdt_.number_of_vertices(); ++guard) {
+    FaceHandle f;
+    int i = 0;
+    if (cdt_.is_edge(cur, b, f, i)) {
+      generations_[EdgeKey(cur, b)] = generation;
+      return;
+    }
+    VertexHandle next;
+    auto c = cdt_.incident_vertices(cur), done = c;
+    do {
+      const VertexHandle w = c;
+      if (cdt_.is_infinite(w) || w == prev) continue;
+      if (orient(a->point(), b->point(), w->point()) != CGAL::COLLINEAR) continue;
+      if ((xy(w) - xy(cur)).dot(xy(b) - xy(cur)) <= 0.0) continue;
+      if (cdt_.is_edge(cur, w, f, i) && f->is_constrained(i)) {
+        next = w;
+        break;
+      }
+    } while (++c != done);
+    if (next == VertexHandle()) return;  // cannot happen: CGAL enforced the segment
+    generations_[EdgeKey(cur, next)] = generation;
+    prev = cur;
+    cur = next;
+  }
+}
+
+void TinTerrain::unconstrain(VertexHandle a, VertexHandle b) {
+  generations_.erase(EdgeKey(a, b));
+  FaceHandle f;
+  int i = 0;
+  if (cdt_.is_edge(a, b, f, i) && f->is_constrained(i)) cdt_.remove_constrained_edge(f, i);
+}
+
+bool TinTerrain::has_constraints(VertexHandle v) const { return cdt_.are_there_incident_constraints(v); }
+
+double TinTerrain::vertex_area(VertexHandle v) const {
+  double area = 0.0;
+  auto c = cdt_.incident_faces(v), done = c;
+  do {
+    if (!cdt_.is_infinite(c)) area += face_area(c);
+  } while (++c != done);
+  return area / 3.0;
+}
+
+void TinTerrain::set_z(VertexHandle v, double z) {
+  const Point& p = v->point();
+  v->set_point(Point(p.x(), p.y(), z));
+}
+
+namespace {
+
+// Whether the circumcircle of f (in xy) comes within `margin` of the box.
+bool circumcircle_meets(FaceHandle f, const Aabb2& box, double margin) {
+  const Point &a = f->vertex(0)->point(), &b = f->vertex(1)->point(), &c = f->vertex(2)->point();
+  const double bx = b.x() - a.x(), by = b.y() - a.y(), cx = c.x() - a.x(), cy = c.y() - a.y();
+  const double d = 2.0 * (bx * cy - by * cx);
+  if (!(std::abs(d) > 0.0)) return true;
+  const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
+  const double ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
+  const double r = std::sqrt(ux * ux + uy * uy);
+  if (!std::isfinite(r)) return true;
+  const double ox = a.x() + ux, oy = a.y() + uy;
+  const double dx = std::max({box.lo.x() - ox, 0.0, ox - box.hi.x()});
+  const double dy = std::max({box.lo.y() - oy, 0.0, oy - box.hi.y()});
+  const double reach = r * (1.0 + 1e-9) + margin;
+  return dx * dx + dy * dy <= reach * reach;
+}
+
+}  // namespace
+
+Capture TinTerrain::begin_capture(const Aabb2& box) {
+  Capture c;
+  const std::uint32_t inside = next_face_epoch();
+  const std::uint32_t outside = next_face_epoch();
+  const double margin = 1e-9 * std::max(domain_.size_m.x(), domain_.size_m.y()) + spec_.snap_m;
+  const Location loc = locate(clamp_to_domain(0.5 * (box.lo + box.hi)));
+  face_scratch_.clear();
+  face_scratch_.push_back(loc.face);
+  loc.face->info() = inside;
+  for (std::size_t k = 0; k < face_scratch_.size(); ++k) {
+    const FaceHandle f = face_scratch_[k];
+    c.volume += face_volume(f);
+    c.area += face_area(f);
+    for (int i = 0; i < 3; ++i) {
+      const FaceHandle n = f->neighbor(i);
+      if (cdt_.is_infinite(n) || n->info() == inside || n->info() == outside) continue;
+      if (circumcircle_meets(n, box, margin)) {
+        n->info() = inside;
+        face_scratch_.push_back(n);
+      } else {
+        n->info() = outside;
+        c.outer.push_back({n, {&*n->vertex(0), &*n->vertex(1), &*n->vertex(2)}, n->index(f)});
+      }
+    }
+  }
+  c.faces = face_scratch_.size();
+  std::sort(c.outer.begin(), c.outer.end(),
+            [](const OuterFace& x, const OuterFace& y) { return &*x.face < &*y.face; });
+  return c;
+}
+
+CaptureResult TinTerrain::end_capture(Capture& c, std::vector<VertexHandle>* region_vertices) {
+  CaptureResult r;
+  r.volume_before = c.volume;
+  r.area_before = c.area;
+  auto is_outer = [&c](FaceHandle f) {
+    const auto it = std::lower_bound(c.outer.begin(), c.outer.end(), &*f,
+                                     [](const OuterFace& o, const void* p) { return &*o.face < p; });
+    return it != c.outer.end() && &*it->face == &*f;
+  };
+  // The outer faces must have survived unchanged; then they fence in the same area.
+  bool intact = true;
+  FaceHandle start;
+  for (const OuterFace& o : c.outer) {
+    const FaceHandle f = o.face;
+    if (!cdt_.tds().faces().is_used(f) || &*f->vertex(0) != o.vertices[0] || &*f->vertex(1) != o.vertices[1] ||
+        &*f->vertex(2) != o.vertices[2]) {
+      intact = false;
+      continue;
+    }
+    const FaceHandle n = f->neighbor(o.toward);
+    if (start == FaceHandle() && !cdt_.is_infinite(n) && !is_outer(n)) start = n;
+  }
+  if (start == FaceHandle()) start = cdt_.finite_faces_begin();
+
+  const std::uint32_t after = next_face_epoch();
+  const std::uint32_t seen = region_vertices ? next_vertex_epoch() : 0;
+  if (region_vertices) region_vertices->clear();
+  face_scratch_.clear();
+  face_scratch_.push_back(start);
+  start->info() = after;
+  for (std::size_t k = 0; k < face_scratch_.size(); ++k) {
+    const FaceHandle f = face_scratch_[k];
+    r.volume_after += face_volume(f);
+    r.area_after += face_area(f);
+    for (int i = 0; i < 3; ++i) {
+      if (region_vertices && f->vertex(i)->info().mark != seen) {
+        f->vertex(i)->info().mark = seen;
+        region_vertices->push_back(f->vertex(i));
+      }
+      const FaceHandle n = f->neighbor(i);
+      if (cdt_.is_infinite(n) || n->info() == after || is_outer(n)) continue;
+      n->info() = after;
+      face_scratch_.push_back(n);
+    }
+  }
+  r.faces_after = face_scratch_.size();
+  if (!intact || std::abs(r.area_after - r.area_before) > 1e-9 * std::max(r.area_before, 1e-30)) {
+    ++capture_mismatches_;
+    if (std::getenv("SB_TIN_DEBUG"))
+      std::fprintf(stderr, "capture mismatch: intact %d area %.17g -> %.17g faces %zu -> %zu outer %zu\n", intact,
+                   r.area_before, r.area_after, c.faces, r.faces_after, c.outer.size());
+    r.volume_after = r.volume_before;  // unknown: report no change rather than a wrong one
+  }
+  retriangulation_volume_m3_ += r.delta();
+  return r;
+}
+
+void TinTerrain::collect_vertices(const Aabb2& box, std::vector<VertexHandle>& out) {
+  out.clear();
+  const std::uint32_t visited = next_face_epoch();
+  const std::uint32_t seen = next_vertex_epoch();
+  const Location loc = locate(clamp_to_domain(0.5 * (box.lo + box.hi)));
+  std::vector<FaceHandle>& queue = face_scratch_;
+  queue.clear();
+  queue.push_back(loc.face);
+  loc.face->info() = visited;
+  for (std::size_t k = 0; k < queue.size(); ++k) {
+    const FaceHandle f = queue[k];
+    for (int i = 0; i < 3; ++i) {
+      const VertexHandle v = f->vertex(i);
+      if (v->info().mark != seen) {
+        v->info().mark = seen;
+        if (box.contains(xy(v))) out.push_back(v);
+      }
+      const FaceHandle n = f->neighbor(i);
+      if (cdt_.is_infinite(n) || n->info() == visited) continue;
+      const Point &a = n->vertex(0)->point(), &b = n->vertex(1)->point(), &c = n->vertex(2)->point();
+      const bool overlaps = std::max({a.x(), b.x(), c.x()}) >= box.lo.x() && std::min({a.x(), b.x(), c.x()}) <= box.hi.x() &&
+                            std::max({a.y(), b.y(), c.y()}) >= box.lo.y() && std::min({a.y(), b.y(), c.y()}) <= box.hi.y();
+      if (!overlaps) continue;
+      n->info() = visited;
+      queue.push_back(n);
+    }
+  }
+}
+
+void TinTerrain::touch(VertexHandle v) {
+  VertexInfo& in = v->info();
+  in.idle = 0;
+  if (in.erosion_slot != kNoSlot) return;
+  in.erosion_slot = static_cast<std::uint32_t>(erosion_list_.size());
+  erosion_list_.push_back(v);
+}
+
+void TinTerrain::touch_with_neighbours(VertexHandle v) {
+  touch(v);
+  auto c = cdt_.incident_vertices(v), done = c;
+  do {
+    if (!cdt_.is_infinite(c)) touch(c);
+  } while (++c != done);
+}
+
+void TinTerrain::drop_from_erosion(VertexHandle v) {
+  const std::uint32_t slot = v->info().erosion_slot;
+  if (slot == kNoSlot) return;
+  const VertexHandle last = erosion_list_.back();
+  erosion_list_[slot] = last;
+  last->info().erosion_slot = slot;
+  erosion_list_.pop_back();
+  v->info().erosion_slot = kNoSlot;
+}
+
+void TinTerrain::add_to_simplify(VertexHandle v) {
+  VertexInfo& in = v->info();
+  if (in.simplify_slot != kNoSlot) return;
+  in.simplify_slot = static_cast<std::uint32_t>(simplify_list_.size());
+  simplify_list_.push_back(v);
+}
+
+void TinTerrain::drop_from_simplify(VertexHandle v) {
+  const std::uint32_t slot = v->info().simplify_slot;
+  if (slot == kNoSlot) return;
+  const VertexHandle last = simplify_list_.back();
+  simplify_list_[slot] = last;
+  last->info().simplify_slot = slot;
+  simplify_list_.pop_back();
+  v->info().simplify_slot = kNoSlot;
+}
+
+std::uint32_t TinTerrain::next_face_epoch() {
+  if (face_epoch_ >= 0xFFFFFF00u) {
+    for (auto f = cdt_.all_faces_begin(); f != cdt_.all_faces_end(); ++f) f->info() = 0;
+    face_epoch_ = 0;
+  }
+  return ++face_epoch_;
+}
+
+std::uint32_t TinTerrain::next_vertex_epoch() {
+  if (vertex_epoch_ >= 0xFFFFFF00u) {
+    for (auto v = cdt_.finite_vertices_begin(); v != cdt_.finite_vertices_end(); ++v) v->info().mark = 0;
+    vertex_epoch_ = 0;
+  }
+  return ++vertex_epoch_;
+}
+
+}  // namespace sb::tin::detail
