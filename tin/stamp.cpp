@@ -213,7 +213,7 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
       for (std::size_t i = 0; i < ring.size(); ++i) perimeter += (ring[(i + 1) % ring.size()] - ring[i]).norm();
       const double needed = 0.5 * perimeter / static_cast<double>(ring.size());
       for (const Vec2& p : ring) {
-        if (!box_.contains(p) || point_in_polygon(outer, p)) continue;
+        if (!box_.contains(p) || point_in_polygon(outer, p) || s.rim_weight(p) <= 0.0) continue;
         const Location loc = locate(p);
         bool has_near = false;
         for (int i = 0; i < 3; ++i) has_near = has_near || (xy(loc.face->vertex(i)) - p).norm() < needed;
@@ -377,14 +377,17 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   const Aabb2 band_box = intersect(s.influence_bounds(), box_);
   collect_vertices(band_box, vertex_scratch_);
   std::vector<VertexHandle> band_vertices;
+  // rim_weight: 0 inside the footprint; the inner contour lies on its boundary, which
+  // point-in-polygon may put either side, so it is excluded explicitly.
+  auto rim_weight = [&](const Vec2& p) { return in_footprint(p) ? 0.0 : s.rim_weight(p); };
   for (VertexHandle v : vertex_scratch_)
-    if (s.rim_weight(xy(v)) > 0.0) band_vertices.push_back(v);
+    if (rim_weight(xy(v)) > 0.0) band_vertices.push_back(v);
   for (VertexHandle v : band_vertices) report.vertices_inserted += refine_around(v);
   collect_vertices(band_box, vertex_scratch_);
   std::vector<std::pair<VertexHandle, double>> targets;
   double weight_sum = 0.0;
   for (VertexHandle v : vertex_scratch_) {
-    const double w = s.rim_weight(xy(v));
+    const double w = rim_weight(xy(v));
     if (w <= 0.0) continue;
     const double wa = w * vertex_area(v);
     targets.emplace_back(v, wa);

@@ -1,0 +1,250 @@
+// Stamping on the TIN (the paper's step 1a-1f): contours constrained, depth reached,
+// displaced volume on the rim, old generations dropped, degenerate input refused.
+#include <numbers>
+
+#include "common/input_error.hpp"
+#include "tests/unit/tin_test_support.hpp"
+
+namespace sb::tin::test {
+namespace {
+
+double footprint_area(const ToolStamp& st) { return std::abs(signed_area(st.footprint)); }
+
+TEST(TinStamp, ConstrainsTheOuterAndInnerContours) {
+  const Scene s = scene();
+  auto t = make(s);
+  const ToolStamp st = stamp_at(s, {0.25, 0.25}, 0.09);
+  const StampReport r = t->stamp(st);
+  SB_EXPECT_TIN_OK(*t);
+  // Flat terrain: O is not subdivided, so 32 outer and 32 inner constrained edges.
+  EXPECT_EQ(t->stats().constrained_edges, 64u);
+  EXPECT_GE(r.vertices_inserted, 64u);
+  const SurfaceMesh m = t->mesh();
+  const double gap = 0.05 * std::sqrt(footprint_area(st) / std::numbers::pi);
+  std::size_t inner = 0, outer = 0;
+  for (const auto& e : m.constrained_edges) {
+    const Vec3 &a = m.vertices[e[0]], &b = m.vertices[e[1]];
+    const double da = distance_to_boundary(st.footprint, a.head<2>());
+    const double db = distance_to_boundary(st.footprint, b.head<2>());
+    if (da < 1e-12 && db < 1e-12) {
+      ++inner;
+      EXPECT_NEAR(a.z(), 0.09, 1e-15);  // I at tool depth
+      EXPECT_NEAR(b.z(), 0.09, 1e-15);
+    } else {
+      ++outer;
+      // Mitred offset: gap from the edges, gap / cos(pi / 32) from the polygon's corners.
+      EXPECT_NEAR(da, gap, 0.01 * gap);
+      EXPECT_NEAR(db, gap, 0.01 * gap);
+      EXPECT_FALSE(st.contains(a.head<2>()));
+      EXPECT_GT(a.z(), 0.1 - 1e-12);  // O follows the terrain (plus any deposit)
+    }
+  }
+  EXPECT_EQ(inner, 32u);
+  EXPECT_EQ(outer, 32u);
+}
+
+TEST(TinStamp, ReachesTheToolDepthInsideTheFootprint) {
+  for (const char* text : {kFlatScene, kDunesScene}) {
+    const Scene s = scene(text);
+    auto t = make(s);
+    const Vec2 c(0.25, 0.25);
+    const double bottom = t->height(c) - 0.008;
+    const ToolStamp st = stamp_at(s, c, bottom, {0.6, 0.8});
+    t->stamp(st);
+    SB_EXPECT_TIN_OK(*t);
+    const double r = s.tool.radius_m;
+    for (int k = 0; k < 200; ++k) {
+      const double a = 2.0 * std::numbers::pi * k / 200.0, rho = r * 0.97 * std::sqrt((k % 10) / 9.0);
+      const Vec2 p = c + rho * Vec2(std::cos(a), std::sin(a));
+      if (!st.contains(p)) continue;
+      EXPECT_LE(t->height(p), bottom + 1e-12) << "inside the footprint at " << p.transpose();
+    }
+  }
+}
+
+TEST(TinStamp, SphereCapBottomIsFollowed) {
+  const Scene s = scene(kFlatScene, {"tool.profile=\"sphere_cap\"", "tool.sphere_radius_m=0.05"});
+  auto t = make(s);
+  const Vec2 c(0.25, 0.25);
+  const ToolStamp st = stamp_at(s, c, 0.085);
+  t->stamp(st);
+  SB_EXPECT_TIN_OK(*t);
+  EXPECT_NEAR(t->height(c), 0.085, 1e-12);
+  // Between interior vertices the TIN is linear under the cap: within the chord sag.
+  for (double rho : {0.005, 0.01, 0.015}) {
+    const Vec2 p = c + Vec2(rho, 0.0);
+    EXPECT_NEAR(t->height(p), st.bottom_z(p), 4e-4) << rho;
+    EXPECT_GE(t->height(p), st.bottom_z(p) - 1e-12);
+  }
+}
+
+TEST(TinStamp, DisplacedVolumeGoesToTheRim) {
+  const Scene s = scene();
+  auto t = make(s);
+  const double v0 = t->volume();
+  const ToolStamp st = stamp_at(s, {0.25, 0.25}, 0.09);
+  const StampReport r = t->stamp(st);
+  const double area = footprint_area(st);
+  // The inside is cut by 1 cm, the O-I wall by about half of that.
+  EXPECT_GT(r.volume_removed_m3, area * 0.01);
+  EXPECT_LT(r.volume_removed_m3, area * 0.01 * 1.15);
+  EXPECT_DOUBLE_EQ(r.volume_deposited_m3, r.volume_removed_m3);
+  // On flat sand the contours and rim rings change nothing else: the volume is kept.
+  EXPECT_NEAR(t->volume(), v0, 1e-15);
+  // The sand went to the band outside the footprint, more of it in front.
+  EXPECT_GT(t->height({0.25 + 0.024, 0.25}), 0.1 + 1e-4);
+  EXPECT_GT(t->height({0.25 + 0.024, 0.25}), t->height({0.25 - 0.024, 0.25}));
+  EXPECT_NEAR(t->height({0.25 + 0.05, 0.25}), 0.1, 1e-15);
+}
+
+TEST(TinStamp, ConserveVolumeCompensatesRetriangulation) {
+  for (bool conserve : {false, true}) {
+    const Scene s = scene(kDunesScene, {std::string("tin.conserve_volume=") + (conserve ? "true" : "false")});
+    auto t = make(s);
+    const double v0 = t->volume();
+    double moved = 0.0;
+    for (const ToolStamp& st : schedule_of(s).stamps) moved += t->stamp(st).volume_removed_m3;
+    SB_EXPECT_TIN_OK(*t);
+    const double drift = std::abs(t->volume() - v0);
+    if (conserve) {
+      EXPECT_LT(drift, 1e-12 * v0) << "exact up to rounding";
+    } else {
+      EXPECT_LT(drift, 0.05 * moved) << "flips change the surface, but only a little";
+    }
+  }
+}
+
+TEST(TinStamp, OldGenerationsInsideTheFootprintAreDropped) {
+  const Scene s = scene();
+  auto t = make(s);
+  t->stamp(stamp_at(s, {0.25, 0.25}, 0.09, {1, 0}, 0));
+  EXPECT_EQ(t->stats().constrained_edges, 64u);
+  // The same stamp again: every old constraint is within reach and replaced.
+  t->stamp(stamp_at(s, {0.25, 0.25}, 0.09, {1, 0}, 1));
+  SB_EXPECT_TIN_OK(*t);
+  EXPECT_EQ(t->stats().constrained_edges, 64u);
+  // A stamp far away keeps the first one's constraints.
+  t->stamp(stamp_at(s, {0.1, 0.1}, 0.09, {1, 0}, 2));
+  SB_EXPECT_TIN_OK(*t);
+  EXPECT_EQ(t->stats().constrained_edges, 128u);
+  // A stamp half over the first: the part of its contours out of reach stays.
+  t->stamp(stamp_at(s, {0.27, 0.25}, 0.09, {1, 0}, 3));
+  SB_EXPECT_TIN_OK(*t);
+  EXPECT_GT(t->stats().constrained_edges, 128u);
+  EXPECT_LT(t->stats().constrained_edges, 192u);
+}
+
+TEST(TinStamp, RemovesRedundantInnerVertices) {
+  const Scene s = scene();
+  auto t = make(s);
+  for (int k = 0; k < 5; ++k) t->stamp(stamp_at(s, {0.25 + 0.002 * k, 0.25}, 0.09, {1, 0}, k));
+  SB_EXPECT_TIN_OK(*t);
+  // Inside the last footprint only the inner contour's vertices remain.
+  const ToolStamp last = stamp_at(s, {0.258, 0.25}, 0.09);
+  const SurfaceMesh m = t->mesh();
+  std::size_t strictly_inside = 0;
+  for (const Vec3& v : m.vertices)
+    if (last.contains(v.head<2>()) && distance_to_boundary(last.footprint, v.head<2>()) > 1e-9) ++strictly_inside;
+  EXPECT_EQ(strictly_inside, 0u);
+}
+
+TEST(TinStamp, NearTheBorderAndOffTheDomain) {
+  const Scene s = scene();
+  auto t = make(s);
+  const double v0 = t->volume();
+  // Entirely off the domain: nothing happens.
+  const StampReport off = t->stamp(stamp_at(s, {-0.1, 0.25}, 0.09));
+  EXPECT_EQ(off.vertices_inserted, 0u);
+  EXPECT_EQ(t->stats().vertices, 4u);
+  // Over an edge and over a corner.
+  for (const Vec2& c : {Vec2(0.005, 0.25), Vec2(0.499, 0.001), Vec2(0.5, 0.5), Vec2(0.0, 0.0), Vec2(0.25, -0.019)}) {
+    const StampReport r = t->stamp(stamp_at(s, c, 0.09));
+    SB_EXPECT_TIN_OK(*t);
+    EXPECT_NEAR(r.volume_deposited_m3, r.volume_removed_m3, 1e-18);
+  }
+  EXPECT_NEAR(t->volume(), v0, 1e-6 * v0);
+  // Constrained edges never run along the domain border.
+  const SurfaceMesh m = t->mesh();
+  for (const auto& e : m.constrained_edges) {
+    const Vec3 &a = m.vertices[e[0]], &b = m.vertices[e[1]];
+    const bool along = (a.x() == 0.0 && b.x() == 0.0) || (a.y() == 0.0 && b.y() == 0.0) ||
+                       (a.x() == 0.5 && b.x() == 0.5) || (a.y() == 0.5 && b.y() == 0.5);
+    EXPECT_FALSE(along);
+  }
+}
+
+TEST(TinStamp, ToolAboveTheSurfaceRemovesNothing) {
+  const Scene s = scene();
+  auto t = make(s);
+  const StampReport r = t->stamp(stamp_at(s, {0.25, 0.25}, 0.2));
+  EXPECT_EQ(r.volume_removed_m3, 0.0);
+  EXPECT_EQ(r.volume_deposited_m3, 0.0);
+  EXPECT_NEAR(t->volume(), 0.025, 1e-15);
+  EXPECT_DOUBLE_EQ(t->height({0.25, 0.25}), 0.1);
+  SB_EXPECT_TIN_OK(*t);
+}
+
+TEST(TinStamp, PourAddsItsVolumeWithinItsRadius) {
+  for (bool conserve : {false, true}) {
+    const Scene s = scene(kPileScene, {std::string("tin.conserve_volume=") + (conserve ? "true" : "false")});
+    auto t = make(s);
+    const double v0 = t->volume();
+    const StampReport r = t->stamp(schedule_of(s).stamps.front());
+    SB_EXPECT_TIN_OK(*t);
+    EXPECT_NEAR(t->volume() - v0, 1e-6, 1e-15);  // flat sand: the insertions change nothing
+    EXPECT_NEAR(r.volume_deposited_m3, 1e-6, 1e-18);
+    EXPECT_GT(t->height({0.15, 0.15}), 0.05 + 1e-3);
+    EXPECT_DOUBLE_EQ(t->height({0.15 + 0.0041, 0.15}), 0.05);
+  }
+}
+
+TEST(TinStamp, DegenerateStampsAreRefused) {
+  const Scene s = scene();
+  auto t = make(s);
+  ToolStamp st = stamp_at(s, {0.25, 0.25}, 0.09);
+  ToolStamp two = st;
+  two.footprint.resize(2);
+  EXPECT_THROW(t->stamp(two), InputError);
+  ToolStamp flat = st;
+  for (Vec2& p : flat.footprint) p.y() = 0.25;
+  EXPECT_THROW(t->stamp(flat), InputError);
+  ToolStamp nan_point = st;
+  nan_point.footprint[3].x() = std::nan("");
+  EXPECT_THROW(t->stamp(nan_point), InputError);
+  ToolStamp nan_depth = st;
+  nan_depth.pose.bottom_z = std::nan("");
+  EXPECT_THROW(t->stamp(nan_depth), InputError);
+  ToolStamp pour;
+  pour.pose.xy = {std::nan(""), 0.1};
+  pour.pour_volume_m3 = 1e-6;
+  EXPECT_THROW(t->stamp(pour), InputError);
+  // Nothing was changed by the refused stamps.
+  EXPECT_EQ(t->stats().vertices, 4u);
+  SB_EXPECT_TIN_OK(*t);
+  // A clockwise footprint is accepted (made counter-clockwise).
+  ToolStamp cw = st;
+  std::reverse(cw.footprint.begin(), cw.footprint.end());
+  t->stamp(cw);
+  SB_EXPECT_TIN_OK(*t);
+}
+
+TEST(TinStamp, NonConvexPolygonTool) {
+  const Scene s = parse_scene(R"(
+[domain]
+size_m = [0.5, 0.5]
+[tool]
+shape = "polygon"
+polygon_m = [[-0.02, -0.02], [0.02, -0.02], [0.02, 0.02], [0.0, 0.002], [-0.02, 0.02]]
+depth_m = 0.01
+[stroke]
+path_m = [[0.2, 0.25]]
+)", "polygon");
+  auto t = make(s);
+  for (int k = 0; k < 10; ++k) {
+    t->stamp(stamp_at(s, {0.2 + 0.004 * k, 0.25 + 0.002 * k}, 0.09, {0.9, 0.43}, k));
+    SB_ASSERT_TIN_OK(*t);
+  }
+}
+
+}  // namespace
+}  // namespace sb::tin::test
