@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   sb::cli::add_run_command(app);
   sb::cli::add_compare_command(app);
+  sb::cli::add_interactive_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
