@@ -3,6 +3,7 @@
 // statistics computed from them.
 #include <chrono>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace sb {
@@ -31,6 +32,10 @@ struct StepRecord {
   std::uint64_t vertices = 0, triangles = 0, constrained_edges = 0, cells = 0, bytes = 0;
   std::uint64_t active = 0, erosion_updates = 0, erosion_transfers = 0;
   std::uint64_t elements_touched = 0, removed = 0, walk_steps = 0;
+  // Potential energy per unit weight, sum of z^2 / 2 dA on the comparison raster (m^4);
+  // NaN unless the scene asks for it (output.energy).
+  double energy_m4 = std::numeric_limits<double>::quiet_NaN();
+  double energy_delta_erosion_m4 = std::numeric_limits<double>::quiet_NaN();  // > 0: oscillation
   double total_s() const { return time_tool_s + time_erosion_s + time_simplify_s; }
 };
 

@@ -12,12 +12,14 @@ import time
 from pathlib import Path
 
 import sbrun
+import exp_accuracy
 import exp_alpha_flat
 import exp_drift
 import exp_fig5_6
 import exp_fig7
 import exp_fig8_9
 import exp_memory
+import exp_stability
 
 EXPERIMENTS = {
     "fig5_6": exp_fig5_6,
@@ -26,6 +28,8 @@ EXPERIMENTS = {
     "memory": exp_memory,
     "drift": exp_drift,
     "alpha_flat": exp_alpha_flat,
+    "accuracy": exp_accuracy,
+    "stability": exp_stability,
 }
 
 

@@ -11,8 +11,9 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 FIGURES = ["fig5_tin_shaded.png", "fig5_tin_wireframe.png", "fig6_grid_shaded.png", "fig5_6_side_by_side.png",
            "fig5_6_difference.png", "fig7_time_vs_size.png", "fig8_time_vs_trace.png", "fig9_elements_vs_trace.png",
-           "memory.png", "drift.png", "alpha_flat.png"]
-TABLES = ["fig7_time_vs_size", "fig8_time_vs_trace", "fig9_elements_vs_trace", "memory", "drift", "alpha_flat"]
+           "memory.png", "drift.png", "alpha_flat.png", "accuracy_speed.png"]
+TABLES = ["fig7_time_vs_size", "fig8_time_vs_trace", "fig9_elements_vs_trace", "memory", "drift", "alpha_flat",
+          "accuracy"]
 
 
 def main():
@@ -33,7 +34,10 @@ def main():
             if len(rows) < 2 or not numbers or not all(math.isfinite(x) for x in numbers):
                 sys.exit(f"table {t} holds no finite numbers: {rows}")
         report = (out / "REPORT.md").read_text()
-        for heading in ["Figure 7", "Figure 8", "Figure 9", "Memory", "drift", "alpha_flat", "Figures 5 and 6"]:
+        if not (out / "stability.md").exists():
+            sys.exit("missing stability.md")
+        for heading in ["Figure 7", "Figure 8", "Figure 9", "Memory", "drift", "alpha_flat", "Figures 5 and 6",
+                        "Accuracy", "Stability"]:
             if heading not in report:
                 sys.exit(f"REPORT.md has no section for {heading}")
         # A second run resumes: nothing is run again.

@@ -115,6 +115,8 @@ void for_each_step_field(Fn&& fn) {
   fn("elements_touched", [](const StepRecord& r) { return static_cast<double>(r.elements_touched); });
   fn("vertices_removed", [](const StepRecord& r) { return static_cast<double>(r.removed); });
   fn("walk_steps", [](const StepRecord& r) { return static_cast<double>(r.walk_steps); });
+  fn("energy_m4", [](const StepRecord& r) { return r.energy_m4; });
+  fn("energy_delta_erosion_m4", [](const StepRecord& r) { return r.energy_delta_erosion_m4; });
 }
 
 void write_contents(hid_t file, const RunResult& run, const PreparedScene& p, const Json& summary) {

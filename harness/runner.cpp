@@ -16,6 +16,14 @@ PreparedScene prepare_scene(Scene scene) {
 
 namespace {
 
+// Sum of z^2 / 2 over the raster times the sample area: the potential energy per unit weight.
+double potential_energy(const Terrain& t, Raster raster) {
+  t.sample(raster);
+  double e = 0.0;
+  for (double z : raster.values) e += 0.5 * z * z;
+  return e * raster.spacing_m * raster.spacing_m;
+}
+
 void record_model(StepRecord& r, const ModelStats& st) {
   r.vertices = st.vertices;
   r.triangles = st.triangles;
@@ -29,6 +37,7 @@ void record_model(StepRecord& r, const ModelStats& st) {
 // Erosion then simplification, timed, with the volume change of each phase.
 void erode_and_simplify(Terrain& t, const PreparedScene& p, const ErosionBudget& budget, StepRecord& r,
                         double& volume) {
+  const double energy_before = p.scene.output.energy ? potential_energy(t, p.raster_template) : 0.0;
   Stopwatch sw;
   const ErosionReport er = t.erode(p.rule, budget);
   r.time_erosion_s = sw.seconds();
@@ -37,6 +46,10 @@ void erode_and_simplify(Terrain& t, const PreparedScene& p, const ErosionBudget&
   double v = t.volume();
   r.volume_delta_erosion = v - volume;
   volume = v;
+  if (p.scene.output.energy) {
+    r.energy_m4 = potential_energy(t, p.raster_template);
+    r.energy_delta_erosion_m4 = r.energy_m4 - energy_before;
+  }
 
   sw.restart();
   const SimplifyReport sr = t.simplify(SimplifyParams{p.scene.tin.alpha_flat_deg});

@@ -75,6 +75,12 @@ Json summarize(const RunResult& run, const PreparedScene& p) {
   j["erosion_updates"] = updates;
   j["vertices_removed"] = removed;
   j["walk_steps"] = st.walk_steps;
+  if (p.scene.output.energy) {
+    // Erosion only moves sand downhill: a step whose erosion raised the energy oscillated.
+    std::size_t rises = 0;
+    for (const StepRecord& r : run.steps) rises += r.energy_delta_erosion_m4 > 1e-12 * std::abs(r.energy_m4);
+    j["energy_rises"] = rises;
+  }
   // Accuracy against the scene's analytic reference, when it names one.
   const Json accuracy = accuracy_metrics(p.scene, p.schedule, p.initial, run.initial_raster, run.final_raster);
   for (const auto& [key, value] : accuracy.items()) j[key] = value;
