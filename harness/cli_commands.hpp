@@ -8,5 +8,7 @@ namespace sb::cli {
 void add_run_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
 void add_interactive_command(CLI::App& app);
+void add_render_command(CLI::App& app);
+void add_export_command(CLI::App& app);
 
 }  // namespace sb::cli

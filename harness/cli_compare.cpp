@@ -1,5 +1,5 @@
 // `sandbench compare SCENE [--backends tin,grid] [--out DIR] [--json] [--set k=v ...]`:
-// the same schedule on each back-end (or back-end variant), a table and the summaries.
+// the same schedule on each back-end (or back-end variant), a table, the summaries and pictures.
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -11,6 +11,7 @@
 #include "harness/backends.hpp"
 #include "harness/cli_commands.hpp"
 #include "harness/cli_support.hpp"
+#include "harness/compare_pictures.hpp"
 #include "harness/run_file.hpp"
 
 namespace sb::cli {
@@ -89,7 +90,12 @@ void compare_command(const CompareOptions& o) {
       std::ofstream(tmp) << report.dump(2) << "\n";
     });
     write_atomically(dir / "table.md", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << table; });
-    std::cerr << "wrote " << dir.string() << "/{*.h5,summary.json,table.md}\n";
+    std::vector<PictureRun> pictures;
+    for (const auto& r : runs)
+      pictures.push_back({r.run.label, &r.run.final_mesh, &r.run.initial_raster, &r.run.final_raster, &r.summary});
+    write_compare_pictures(dir, pictures);
+    std::cerr << "wrote " << dir.string() << "/{*.h5,summary.json,table.md,side_by_side.png"
+              << (runs.size() > 1 ? ",difference.png}\n" : "}\n");
   }
   if (o.json) {
     std::cout << report.dump(2) << "\n";
@@ -105,7 +111,7 @@ void add_compare_command(CLI::App& app) {
   cmd->add_option("scene", opts->scene, "Scene file (TOML)")->required();
   cmd->add_option("--backends", opts->backends,
                   "Comma-separated back-ends or variants (default tin,grid), e.g. grid,grid:grid.storage=float");
-  cmd->add_option("--out", opts->out, "Directory for run files, summary.json and table.md");
+  cmd->add_option("--out", opts->out, "Directory for run files, summary.json, table.md, side_by_side.png and difference.png");
   cmd->add_flag("--json", opts->json, "Print the report as JSON on stdout");
   cmd->add_option("--set", opts->overrides, "Override a scene key: --set tool.radius_m=0.03")->take_all();
   cmd->callback([opts] { compare_command(*opts); });

@@ -13,6 +13,8 @@ int main(int argc, char** argv) {
   sb::cli::add_run_command(app);
   sb::cli::add_compare_command(app);
   sb::cli::add_interactive_command(app);
+  sb::cli::add_render_command(app);
+  sb::cli::add_export_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
