@@ -25,7 +25,7 @@ ErosionReport erode_grid(HeightGrid<Real>& grid, ActiveSet& active, const Stenci
       }
       ++report.updates;
       const std::uint32_t k = visiting[v];
-      const std::size_t ix = k % layout.nx, iy = k / layout.nx;
+      const auto [ix, iy] = layout.split(k);
       std::size_t n = 0;
       stencil.for_each(layout, ix, iy, [&](std::size_t jx, std::size_t jy, int slot) {
         const std::uint32_t j = layout.index(jx, jy);
@@ -45,11 +45,11 @@ ErosionReport erode_grid(HeightGrid<Real>& grid, ActiveSet& active, const Stenci
       CompensatedSum given;
       for (std::size_t m = 0; m < n; ++m) {
         if (sent[m] <= 0.0) continue;
-        grid.set(nbr_node[m], nbrs[m].z + sent[m] / nbrs[m].area);
+        grid.set(nbr_node[m], nbrs[m].z + sent[m] / nbrs[m].area, nbrs[m].area);
         given.add(sent[m]);
         ++report.transfers;
       }
-      grid.set(k, z_i - given.value() / area_i);
+      grid.set(k, z_i - given.value() / area_i, area_i);
       moved.add(given.value());
       active.activate(k);
       for (std::size_t m = 0; m < n; ++m) active.activate(nbr_node[m]);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 
 #include "common/geometry.hpp"
 
@@ -52,7 +53,15 @@ struct GridLayout {
   double weight_x(std::size_t ix) const { return ix == 0 || ix + 1 == nx ? 0.5 * dx : dx; }
   double weight_y(std::size_t iy) const { return iy == 0 || iy + 1 == ny ? 0.5 * dy : dy; }
   double area(std::size_t ix, std::size_t iy) const { return weight_x(ix) * weight_y(iy); }
-  double area(std::uint32_t k) const { return area(k % nx, k / nx); }
+  double area(std::uint32_t k) const {
+    const auto [ix, iy] = split(k);
+    return area(ix, iy);
+  }
+  // (ix, iy) of node k, with a single 32-bit division (this is in erosion's inner loop).
+  std::pair<std::size_t, std::size_t> split(std::uint32_t k) const {
+    const std::uint32_t iy = k / static_cast<std::uint32_t>(nx);
+    return {k - iy * static_cast<std::uint32_t>(nx), iy};
+  }
 
   // Nodes inside `box` (closed), clipped to the grid. A node within a billionth of a cell
   // of the box's edge counts as inside: it may lie on the tool's footprint.

@@ -43,6 +43,34 @@ std::vector<Deposit> widened_rim(const GridLayout& layout, const ToolStamp& s) {
   }
 }
 
+// Two circles about the footprint's vertex centroid that classify most nodes of the window
+// without a polygon test: a node inside the inner circle is in the footprint; a node
+// beyond the outer one is outside it, and beyond the outer one plus the rim width it is
+// also past the rim band (its distance to the boundary is at least |p - c| - R). Margins of
+// a billionth keep nodes whose classification rounding could flip on the polygon tests.
+struct FootprintCircles {
+  Vec2 centre{0.0, 0.0};
+  double inner2 = -1.0;  // squared radii
+  double outer2 = 0.0;
+  double band2 = 0.0;
+
+  explicit FootprintCircles(const ToolStamp& s) {
+    for (const Vec2& v : s.footprint) centre += v;
+    centre /= static_cast<double>(s.footprint.size());
+    double outer = 0.0;
+    for (const Vec2& v : s.footprint) outer = std::max(outer, (v - centre).norm());
+    const double margin = 1e-9 * outer;
+    if (s.contains(centre)) {
+      const double inner = distance_to_boundary(s.footprint, centre) - margin;
+      if (inner > 0.0) inner2 = inner * inner;
+    }
+    outer += margin;
+    outer2 = outer * outer;
+    const double band = outer + std::max(0.0, s.rim.width_m) + margin;
+    band2 = band * band;
+  }
+};
+
 template <class Real>
 StampReport cut_and_push(HeightGrid<Real>& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed) {
   const GridLayout& layout = grid.layout();
@@ -51,13 +79,16 @@ StampReport cut_and_push(HeightGrid<Real>& grid, const ToolStamp& s, std::vector
   const NodeRange r = layout.nodes_in(s.influence_bounds());
   if (r.empty) return report;
 
+  const FootprintCircles circles(s);
   std::vector<Cut> cuts;
   std::vector<Deposit> rim;
   for (std::size_t iy = r.y0; iy <= r.y1; ++iy) {
     for (std::size_t ix = r.x0; ix <= r.x1; ++ix) {
       const Vec2 p = layout.position(ix, iy);
+      const double d2 = (p - circles.centre).squaredNorm();
+      if (d2 >= circles.band2) continue;
       const std::uint32_t k = layout.index(ix, iy);
-      if (s.contains(p)) {
+      if (d2 < circles.inner2 || (d2 <= circles.outer2 && s.contains(p))) {
         const double bottom = s.bottom_z(p);
         if (grid.z(k) > bottom) cuts.push_back({k, bottom});
       } else if (const double w = s.rim_weight(p); w > 0.0) {

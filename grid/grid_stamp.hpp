@@ -2,11 +2,11 @@
 // Tool stamps on a height grid (common/tool.hpp's rule): cut the nodes inside the footprint
 // down to the tool bottom and put exactly that volume on the rim band; or pour.
 //
-// Cost: O(nodes in s.influence_bounds() * footprint vertices) -- every node of the window
-// is tested against the footprint and the rim nodes get their distance to its boundary.
-// Only when the rim band holds no node (narrower than a cell, clipped by the domain) is
-// the window widened, doubling the extra width each time: O(log(domain / cell)) rescans
-// at worst. A pour is O(nodes within the pour radius).
+// Cost: O(nodes in s.influence_bounds()) plus O(footprint vertices) for each node near the
+// footprint's boundary or in the rim band; two circles about the footprint decide the
+// other nodes in O(1). Only when the rim band holds no node (narrower than a cell, clipped
+// by the domain) is the window widened, doubling the extra width each time:
+// O(log(domain / cell)) rescans at worst. A pour is O(nodes within the pour radius).
 #include <cstdint>
 #include <vector>
 

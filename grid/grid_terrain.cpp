@@ -21,8 +21,8 @@ StampReport GridTerrain<Real>::stamp(const ToolStamp& s) {
   const GridLayout& layout = grid_.layout();
   for (std::uint32_t k : changed) {
     active_.activate(k);
-    stencil_.for_each(layout, k % layout.nx, k / layout.nx,
-                      [&](std::size_t jx, std::size_t jy, int) { active_.activate(layout.index(jx, jy)); });
+    const auto [ix, iy] = layout.split(k);
+    stencil_.for_each(layout, ix, iy, [&](std::size_t jx, std::size_t jy, int) { active_.activate(layout.index(jx, jy)); });
   }
   return report;
 }

@@ -30,6 +30,9 @@
 //   volume, max_slope_deg,
 //   mesh, check                 O(n)
 //   stats                       O(1)
+// Measured (tests/bench/grid_bench.cpp, 512 x 512, one 2.6 GHz core, CPU time): erosion
+// 26-29 M node updates/s in double, 20-24 M in float (the rounding carry costs ~25 %);
+// a stamp ~80 ns per node of its window, e.g. 3 ms for a 64-cell (32 cm) disk.
 #include <functional>
 #include <memory>
 

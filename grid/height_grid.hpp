@@ -39,12 +39,17 @@ class HeightGrid {
   double z(std::size_t ix, std::size_t iy) const { return z(layout_.index(ix, iy)); }
 
   // Stores `target` (m) at node k; with float storage the rounding error is carried on.
-  void set(std::uint32_t k, double target) {
+  void set(std::uint32_t k, double target) { set(k, target, layout_.area(k)); }
+  // The same, for callers that know the node's area (layout().area(k)) already.
+  void set(std::uint32_t k, double target, double area) {
     if constexpr (std::is_same_v<Real, double>) {
+      (void)area;
       z_[k] = target;
     } else {
-      const double area = layout_.area(k);
-      const double wanted = target + carry_m3_ / area;
+      // 1 / area does not depend on the carry, so it is computed off the carry's chain of
+      // dependent operations, which runs through every float write.
+      const double inverse_area = 1.0 / area;
+      const double wanted = target + carry_m3_ * inverse_area;
       const Real stored = static_cast<Real>(wanted);
       carry_m3_ = (wanted - static_cast<double>(stored)) * area;
       z_[k] = stored;

@@ -1,0 +1,141 @@
+// Grid back-end benchmarks: erosion throughput (cell updates per second) on realistic
+// active sets of a 512 x 512 grid, and stamp cost against tool area; float and double.
+//
+//   build/<dir>/tests/grid_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "common/scene.hpp"
+#include "grid/grid_terrain.hpp"
+
+namespace {
+
+using sb::grid::GridLayout;
+using sb::grid::GridTerrain;
+
+constexpr double kCell = 0.005;
+constexpr std::size_t kNodes = 512;  // per axis
+constexpr double kSize = kCell * (kNodes - 1);
+constexpr double kSand = 0.1;
+
+template <class Real>
+GridTerrain<Real> flat_grid() {
+  const GridLayout layout = GridLayout::covering({{0.0, 0.0}, {kSize, kSize}}, kCell);
+  return GridTerrain<Real>(layout, [](const sb::Vec2&) { return kSand; }, 8, 2);
+}
+
+sb::ToolSpec disk(double radius_m, double depth_m) {
+  sb::ToolSpec spec;
+  spec.shape = sb::ToolShape::Disk;
+  spec.radius_m = radius_m;
+  spec.depth_m = depth_m;
+  spec.rim.width_m = 0.5 * radius_m;
+  return spec;
+}
+
+sb::ToolStamp stamp_at(const sb::ToolSpec& spec, sb::Vec2 xy, sb::Vec2 motion) {
+  sb::ToolPose pose;
+  pose.xy = xy;
+  pose.bottom_z = kSand - spec.depth_m;
+  pose.heading_rad = std::atan2(motion.y(), motion.x());
+  return sb::make_stamp(spec, pose, motion, 0);
+}
+
+sb::ErosionRule rule() {
+  sb::Material m;  // 30 degrees, fraction 0.5
+  return sb::ErosionRule::from(m, 0.1);
+}
+
+// Two starting states for erosion.
+enum class Start { Pile, Stroke };
+
+// Pile: a column of 2 litres poured 10 cm wide in the middle, relaxing into a cone.
+// Stroke: a 5 cm disk dragged 3 cm deep over 40 cm (41 stamps), its trench and rims eroding.
+template <class Real>
+GridTerrain<Real> prepared(Start start) {
+  GridTerrain<Real> t = flat_grid<Real>();
+  const sb::Vec2 centre{kSize / 2, kSize / 2};
+  if (start == Start::Pile) {
+    sb::ToolSpec pour;
+    pour.shape = sb::ToolShape::Pour;
+    pour.radius_m = 0.05;
+    pour.pour_volume_m3 = 2e-3;
+    sb::ToolPose pose;
+    pose.xy = centre;
+    t.stamp(sb::make_stamp(pour, pose, sb::Vec2::Zero(), 0));
+  } else {
+    const sb::ToolSpec spec = disk(0.05, 0.03);
+    for (int i = 0; i <= 40; ++i)
+      t.stamp(stamp_at(spec, centre + sb::Vec2(-0.2 + 0.01 * i, 0.0), {1.0, 0.0}));
+  }
+  return t;
+}
+
+// state.range(0) erosion passes on a fresh copy of the prepared state each iteration (the
+// copy is not timed). Rates are per CPU second.
+template <class Real, Start kStart>
+void BM_Erosion(benchmark::State& state) {
+  const int passes = static_cast<int>(state.range(0));
+  const GridTerrain<Real> start = prepared<Real>(kStart);
+  const sb::ErosionRule r = rule();
+  double updates = 0, transfers = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    GridTerrain<Real> t = start;
+    state.ResumeTiming();
+    const sb::ErosionReport report = t.erode(r, {.max_passes = passes});
+    benchmark::DoNotOptimize(report);
+    updates += static_cast<double>(report.updates);
+    transfers += static_cast<double>(report.transfers);
+  }
+  state.counters["updates_per_s"] = benchmark::Counter(updates, benchmark::Counter::kIsRate);
+  state.counters["transfers_per_s"] = benchmark::Counter(transfers, benchmark::Counter::kIsRate);
+  state.counters["updates_per_call"] = benchmark::Counter(updates, benchmark::Counter::kAvgIterations);
+  state.counters["active_at_start"] = static_cast<double>(start.stats().active);
+}
+BENCHMARK(BM_Erosion<float, Start::Pile>)->Name("BM_ErosionPile<float>")->ArgName("passes")->Arg(64)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Erosion<double, Start::Pile>)->Name("BM_ErosionPile<double>")->ArgName("passes")->Arg(64)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Erosion<float, Start::Stroke>)->Name("BM_ErosionStroke<float>")->ArgName("passes")->Arg(64)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Erosion<double, Start::Stroke>)->Name("BM_ErosionStroke<double>")->ArgName("passes")->Arg(64)->Unit(benchmark::kMillisecond);
+
+// One stamp of a disk of the given radius (in cells) on fresh sand: stamps walk a lattice
+// of positions far enough apart that none overlaps the last; the grid is reset (untimed)
+// when the lattice is used up.
+template <class Real>
+void BM_Stamp(benchmark::State& state) {
+  const double radius = static_cast<double>(state.range(0)) * kCell;
+  const sb::ToolSpec spec = disk(radius, 0.01);
+  const double pitch = 2.0 * (radius + spec.rim.width_m) + 2 * kCell;
+  std::vector<sb::ToolStamp> stamps;
+  for (double y = pitch / 2; y + pitch / 2 < kSize; y += pitch)
+    for (double x = pitch / 2; x + pitch / 2 < kSize; x += pitch) stamps.push_back(stamp_at(spec, {x, y}, {1.0, 0.0}));
+  const GridTerrain<Real> fresh = flat_grid<Real>();
+  GridTerrain<Real> t = fresh;
+  std::size_t next = 0;
+  double touched = 0, window = 0;
+  const GridLayout& layout = fresh.layout();
+  for (auto _ : state) {
+    if (next == stamps.size()) {
+      state.PauseTiming();
+      t = fresh;
+      next = 0;
+      state.ResumeTiming();
+    }
+    const sb::ToolStamp& s = stamps[next++];
+    const sb::StampReport report = t.stamp(s);
+    benchmark::DoNotOptimize(report);
+    touched += static_cast<double>(report.elements_touched);
+    window += static_cast<double>(layout.nodes_in(s.influence_bounds()).count());
+  }
+  state.counters["radius_cells"] = static_cast<double>(state.range(0));
+  state.counters["area_m2"] = std::numbers::pi * radius * radius;
+  state.counters["nodes_touched"] = benchmark::Counter(touched, benchmark::Counter::kAvgIterations);
+  state.counters["nodes_in_window"] = benchmark::Counter(window, benchmark::Counter::kAvgIterations);
+  state.counters["window_nodes_per_s"] = benchmark::Counter(window, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_Stamp<float>)->ArgName("radius_cells")->RangeMultiplier(2)->Range(2, 64)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_Stamp<double>)->ArgName("radius_cells")->RangeMultiplier(2)->Range(2, 64)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
