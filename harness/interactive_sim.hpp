@@ -79,6 +79,7 @@ class Simulation {
 
   // After stop().
   SimTotals totals() const;
+  const Terrain& terrain() const { return *terrain_; }
   std::string recording_error() const;  // empty when every recording was written
 
  private:

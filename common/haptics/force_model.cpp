@@ -106,12 +106,12 @@ LimitedForce limit_force(const Vec3& force_n, double max_force_n) {
     return out;
   }
   const double limit = std::max(0.0, max_force_n);
-  const double norm = force_n.norm();
+  double norm = force_n.norm();
+  if (!std::isfinite(norm)) norm = force_n.stableNorm();  // huge components overflow the plain norm
   if (norm > limit) {
-    out.force_n = force_n * (limit / norm);
+    // A hair under the limit, so that rounding in the scaled norm cannot exceed it.
+    out.force_n = force_n * (limit / norm * (1.0 - 1e-12));
     out.clamped = true;
-    // Rounding may leave the scaled norm an ulp above the limit.
-    if (out.force_n.norm() > limit) out.force_n *= std::nextafter(1.0, 0.0);
   } else {
     out.force_n = force_n;
   }

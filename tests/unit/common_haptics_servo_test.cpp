@@ -1,0 +1,171 @@
+// The servo: one tick (ServoCore) and the 1 kHz loop (ServoLoop) with a simulation-like
+// publisher running beside it. Rates and timings are reported by the app, never asserted.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <thread>
+
+#include "common/haptics/replay_device.hpp"
+#include "common/haptics/servo_loop.hpp"
+#include "common/haptics/shared_pose_device.hpp"
+#include "common_haptics_test_support.hpp"
+
+namespace sb::haptics {
+namespace {
+
+const Vec2 kCentre(0.3, 0.3);
+
+DeviceLimits limits(double max_force_n = 4.0, double max_stiffness = 2000.0) {
+  DeviceLimits l;
+  l.max_force_n = max_force_n;
+  l.max_stiffness_n_per_m = max_stiffness;
+  l.workspace.lo = Vec3(0.0, 0.0, 0.0);
+  l.workspace.hi = Vec3(1.0, 1.0, 0.3);
+  return l;
+}
+
+void publish(PatchBuffer& b, const HeightPatch& p) {
+  b.back() = p;
+  b.publish();
+}
+
+TEST(HapticsServoCore, CommandsTheModelsForceWithinTheDeviceLimit) {
+  SharedPoseDevice device("test", limits(4.0));
+  PatchBuffer patches;
+  const ForceParams params = ForceParams::from(test::sand(800.0), test::disk(0.02));
+  publish(patches, test::flat_patch(0.1, kCentre, params));
+  ServoCore core(device, patches);
+  core.start();
+
+  ServoState s = core.step(0.0);  // no pose yet: nothing
+  EXPECT_FALSE(s.device.valid);
+  EXPECT_EQ(s.force_n, Vec3::Zero());
+
+  device.set_pose(Vec3(kCentre.x(), kCentre.y(), 0.1 - 0.002), 0);
+  s = core.step(0.001);
+  EXPECT_TRUE(s.model.in_contact);
+  EXPECT_NEAR(s.force_n.z(), 800.0 * 0.002, 1e-9);
+  EXPECT_FALSE(s.clamped);
+  EXPECT_EQ(s.patch_version, 1u);
+
+  device.set_pose(Vec3(kCentre.x(), kCentre.y(), 0.1 - 0.02), 0);  // 16 N asked, 4 N allowed
+  s = core.step(0.002);
+  EXPECT_TRUE(s.clamped);
+  EXPECT_LE(s.force_n.norm(), 4.0);
+  EXPECT_NEAR(s.force_n.norm(), 4.0, 1e-9);
+  EXPECT_GT(s.model.force_n.norm(), 4.0);
+  EXPECT_LE(device.max_commanded_force_n(), 4.0);
+}
+
+TEST(HapticsServoCore, EstimatesVelocityFromPositions) {
+  SharedPoseDevice device("test", limits());
+  PatchBuffer patches;
+  publish(patches, test::flat_patch(0.0, kCentre, ForceParams::from(test::sand(), test::disk(0.02))));
+  ServoCore core(device, patches, 40.0);
+  core.start();
+  const Vec3 v(0.05, -0.02, 0.01);
+  ServoState s;
+  for (int i = 0; i < 400; ++i) {
+    const double t = i * 0.001;
+    device.set_pose(Vec3(0.3, 0.3, 0.1) + t * v, 0);
+    s = core.step(t);
+  }
+  EXPECT_TRUE(s.velocity_m_s.isApprox(v, 1e-6)) << s.velocity_m_s.transpose();
+}
+
+// The loop with a replay device pressing into the sand and a second thread publishing
+// patches all the while, as the simulation does. Every force must be finite and within the
+// limit; the statistics must be coherent.
+TEST(HapticsServoLoop, RunsBesideAPublisherAndKeepsForcesWithinLimits) {
+  Trajectory t;
+  for (int i = 0; i <= 100; ++i) {
+    const double u = i / 100.0;
+    t.samples.push_back({0.4 * u, Vec3(kCentre.x() + 0.02 * u, kCentre.y(), 0.105 - 0.03 * u), 0});
+  }
+  ReplayDevice device(t, limits(3.0, 1000.0));
+  PatchBuffer patches;
+  reserve_patches(patches, 49);
+  const ForceParams params = ForceParams::from(test::sand(5000.0), test::disk(0.02));
+  const HeightPatch flat = test::flat_patch(0.1, kCentre, params);
+  publish(patches, flat);
+
+  ServoOptions options;
+  options.realtime = false;  // a test must not take the machine's real-time priority
+  ServoLoop loop(device, patches, options);
+  loop.set_recording(true);
+  std::atomic<bool> stop{false};
+  std::uint64_t published = 0;
+  std::thread simulation([&] {
+    HeightPatch p = flat;
+    while (!stop.load()) {
+      p.version = ++published + 1;
+      publish(patches, p);
+      std::this_thread::sleep_for(std::chrono::microseconds(300));
+    }
+  });
+  loop.start();
+  // Read what the servo publishes for the simulation, as it would.
+  std::uint64_t states = 0;
+  bool finite = true;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(600);
+  while (std::chrono::steady_clock::now() < until) {
+    if (loop.to_simulation().update()) {
+      ++states;
+      finite &= loop.to_simulation().front().force_n.allFinite();
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  loop.stop();
+  stop.store(true);
+  simulation.join();
+
+  const ServoStats s = loop.stats();
+  EXPECT_GT(s.ticks, 10u);
+  EXPECT_GT(states, 0u);
+  EXPECT_TRUE(finite);
+  EXPECT_EQ(s.forces_nonfinite, 0u);
+  EXPECT_LE(s.force_max_n, 3.0);
+  EXPECT_LE(device.max_commanded_force_n(), 3.0);
+  EXPECT_GT(s.force_max_n, 0.0);  // the replay pressed 2.5 cm into the sand
+  EXPECT_GT(s.forces_clamped, 0u);
+  EXPECT_GT(s.ticks_in_contact, 0u);
+  EXPECT_EQ(s.force_limit_n, 3.0);
+  EXPECT_LE(s.tick_us_p50, s.tick_us_p99);
+  EXPECT_LE(s.tick_us_p99, s.tick_us_max);
+  EXPECT_GT(s.servo_hz, 0.0);
+  EXPECT_GT(s.duration_s, 0.0);
+  // Recording: every tick queued, in time order.
+  ServoSample r;
+  std::uint64_t samples = 0;
+  double last_t = -1.0;
+  bool ordered = true;
+  while (loop.samples().pop(r)) {
+    ordered &= r.t_s > last_t;
+    last_t = r.t_s;
+    ++samples;
+  }
+  EXPECT_TRUE(ordered);
+  EXPECT_EQ(samples + s.samples_dropped, s.ticks);
+}
+
+TEST(HapticsServoLoop, StopIsIdempotentAndStartsAgain) {
+  SharedPoseDevice device("test", limits());
+  PatchBuffer patches;
+  ServoOptions options;
+  options.realtime = false;
+  ServoLoop loop(device, patches, options);
+  loop.stop();
+  loop.start();
+  EXPECT_TRUE(loop.running());
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  loop.stop();
+  loop.stop();
+  EXPECT_FALSE(loop.running());
+  EXPECT_GT(loop.stats().ticks, 0u);
+  EXPECT_EQ(loop.stats().ticks_without_pose, loop.stats().ticks);
+  EXPECT_EQ(loop.stats().force_max_n, 0.0);
+}
+
+}  // namespace
+}  // namespace sb::haptics
