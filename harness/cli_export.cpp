@@ -29,6 +29,7 @@ void export_command(const ExportOptions& o) {
   const std::filesystem::path out = o.out;
   if (out.has_parent_path() && !std::filesystem::is_directory(out.parent_path()))
     throw InputError("-o " + out.string() + ": directory " + out.parent_path().string() + " does not exist");
+  if (std::filesystem::is_directory(out)) throw InputError("-o " + out.string() + " is a directory; give a file name");
   const RunFile run = read_run_file(o.run);
   const std::string label = attribute(run, "label").empty() ? attribute(run, "backend") : attribute(run, "label");
   const std::vector<std::string> comments = {std::string("sandbench ") + kVersion + " export of " +

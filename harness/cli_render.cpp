@@ -51,6 +51,7 @@ void render_command(const RenderCliOptions& o) {
   const std::filesystem::path out = o.out;
   if (out.has_parent_path() && !std::filesystem::is_directory(out.parent_path()))
     throw InputError("-o " + out.string() + ": directory " + out.parent_path().string() + " does not exist");
+  if (std::filesystem::is_directory(out)) throw InputError("-o " + out.string() + " is a directory; give a file name");
 
   const RunFile run = read_run_file(o.run);
   const RenderFrame frame = make_frame({{&run.initial_raster, &run.final_raster}}, region);

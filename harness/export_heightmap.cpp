@@ -1,6 +1,6 @@
 #include <algorithm>
+#include <charconv>
 #include <cmath>
-#include <cstdio>
 #include <fstream>
 #include <stdexcept>
 
@@ -10,10 +10,11 @@
 namespace sb {
 
 namespace {
+// Shortest text that reads back as the same double ("0.0025", not "0.0025000000000000001").
 std::string number(double v) {
   char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
 }
 
 std::string pair(const Vec2& v) {

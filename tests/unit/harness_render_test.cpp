@@ -354,6 +354,8 @@ TEST_F(RenderCli, BadInputExitsTwoNamesTheOptionAndWritesNothing) {
   r = sandbench("render " + run_.string() + " -o " + (dir_ / "no" / "such" / "dir.png").string());
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("-o"), std::string::npos) << r.out;
+  r = sandbench("render " + run_.string() + " -o " + dir_.string());
+  EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_EQ(sandbench("render " + run_.string()).code, 2);  // -o is required
   EXPECT_FALSE(fs::exists(out));
   EXPECT_EQ(files(), 2u);  // the run file and not_a_run.h5
