@@ -166,24 +166,24 @@ Mat4 ortho(double l, double r, double b, double t, double n, double f) {
   return m;
 }
 
-// The camera for a frame, in coordinates relative to `centre`.
-Mat4 camera(const RenderFrame& frame, const RenderMesh& mesh, View view, double aspect) {
-  const Vec3& c = mesh.centre;
+// The camera for a frame, in coordinates relative to `c`. It depends on the frame alone, so
+// every back-end drawn with one frame is seen from one place.
+Mat4 camera(const RenderFrame& frame, const Vec3& c, View view, double aspect) {
   const Vec2 lo = frame.region.lo - c.head<2>(), hi = frame.region.hi - c.head<2>();
-  const double z_lo = std::min(frame.z_min_m, mesh.z_min_m) - c.z();
-  const double z_hi = std::max(frame.z_max_m, mesh.z_max_m) - c.z();
-  const double reach = (frame.domain.hi - frame.domain.lo).norm() + (z_hi - z_lo) + c.z() + 1.0;
+  const double z_lo = frame.z_min_m - c.z(), z_hi = frame.z_max_m - c.z();
+  // Depth room for everything outside the region: the domain, hills up to a metre, skirts.
+  const double reach = (frame.domain.hi - frame.domain.lo).norm() + (z_hi - z_lo) + std::abs(c.z()) + 1.0;
   if (view == View::Top) {
     const Vec2 mid = (lo + hi) / 2.0, half = (hi - lo) / 2.0;
     double hw = half.x(), hh = half.y();
     if (hw < hh * aspect) hw = hh * aspect;
     else hh = hw / aspect;
-    const double eye_z = z_hi + 1.0;
+    const double eye_z = z_hi + reach;
     Mat4 view_m = Mat4::Identity();
     view_m(0, 3) = -mid.x();
     view_m(1, 3) = -mid.y();
     view_m(2, 3) = -eye_z;
-    return ortho(-hw, hw, -hh, hh, 0.5, eye_z + c.z() + 1.0) * view_m;
+    return ortho(-hw, hw, -hh, hh, 0.0, eye_z + reach) * view_m;
   }
   const double b = kViewBearingDeg * kDeg, e = kViewElevationDeg * kDeg;
   const Vec3 to_eye(std::sin(b) * std::cos(e), std::cos(b) * std::cos(e), std::sin(e));
@@ -338,7 +338,7 @@ Image Renderer::render(const SurfaceMesh& mesh, const RenderFrame& frame, const 
   const Vec2 mid = (frame.region.lo + frame.region.hi) / 2.0;
   const RenderMesh rm =
       prepare_render_mesh(mesh, Vec3(mid.x(), mid.y(), (frame.z_min_m + frame.z_max_m) / 2.0), o.wireframe);
-  const Eigen::Matrix4f mvp = camera(frame, rm, o.view, static_cast<double>(o.width) / o.height).cast<float>();
+  const Eigen::Matrix4f mvp = camera(frame, rm.centre, o.view, static_cast<double>(o.width) / o.height).cast<float>();
 
   glViewport(0, 0, w, h);
   glClearColor(kBackground[0], kBackground[1], kBackground[2], 1.0f);

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <array>
-#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -27,14 +26,7 @@ RenderMesh prepare_render_mesh(const SurfaceMesh& mesh, const Vec3& centre, bool
   out.centre = centre;
   const std::size_t nv = mesh.vertices.size();
   out.positions.reserve(3 * nv);
-  out.z_min_m = std::numeric_limits<double>::infinity();
-  out.z_max_m = -out.z_min_m;
-  for (const Vec3& p : mesh.vertices) {
-    push3(out.positions, p - centre);
-    out.z_min_m = std::min(out.z_min_m, p.z());
-    out.z_max_m = std::max(out.z_max_m, p.z());
-  }
-  if (nv == 0) out.z_min_m = out.z_max_m = 0.0;
+  for (const Vec3& p : mesh.vertices) push3(out.positions, p - centre);
 
   std::vector<Vec3> normal(nv, Vec3::Zero());
   out.triangles.reserve(3 * mesh.triangles.size());

@@ -22,7 +22,6 @@ struct RenderMesh {
   std::vector<std::uint32_t> constrained;  // 2 per constrained edge
   std::vector<float> skirt_positions;      // 6 vertices (2 triangles) per boundary edge
   std::vector<float> skirt_normals;
-  double z_min_m = 0.0, z_max_m = 0.0;     // height range of the vertices (absolute)
 };
 
 // Throws std::invalid_argument when an index is out of range.
