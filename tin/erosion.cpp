@@ -102,7 +102,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& bu
         for (std::size_t k = 0; k < nbr_scratch_.size(); ++k)
           if (transfer_scratch_[k] > 0.0) splits += refine_around(vertex_scratch_[k]);
         if (splits == 0) break;
-                area = gather(cdt_, v, vertex_scratch_, nbr_scratch_);
+        area = gather(cdt_, v, vertex_scratch_, nbr_scratch_);
         transfer_scratch_.resize(nbr_scratch_.size());
         total = erosion_transfers(v->point().z(), area, nbr_scratch_, rule, transfer_scratch_);
       }

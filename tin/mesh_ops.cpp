@@ -3,8 +3,6 @@
 // simplification lists, and region captures for measuring retriangulation volume changes.
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "common/input_error.hpp"
 #include "tin/detail/tin_impl.hpp"
@@ -352,9 +350,6 @@ CaptureResult TinTerrain::end_capture(Capture& c, std::vector<VertexHandle>* reg
   r.faces_after = face_scratch_.size();
   if (!intact || std::abs(r.area_after - r.area_before) > 1e-9 * std::max(r.area_before, 1e-30)) {
     ++capture_mismatches_;
-    if (std::getenv("SB_TIN_DEBUG"))
-      std::fprintf(stderr, "capture mismatch: intact %d area %.17g -> %.17g faces %zu -> %zu outer %zu\n", intact,
-                   r.area_before, r.area_after, c.faces, r.faces_after, c.outer.size());
     r.volume_after = r.volume_before;  // unknown: report no change rather than a wrong one
   }
   retriangulation_volume_m3_ += r.delta();

@@ -223,9 +223,12 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   }
 
   // Old constraints within reach of O are dropped (whatever their generation): afterwards no
-  // old constraint can touch or cross the new ones, which all lie inside O.
+  // old constraint can touch or cross the new ones, which all lie inside O. The reach extends
+  // a gap beyond O, where old vertices are cleared (below) so that repeated stamps at one
+  // spot (or turning ones) do not pile up contour vertices just outside each other.
+  const double clearance = gap;
   std::vector<std::pair<VertexHandle, VertexHandle>> dropped;
-  Aabb2 reach = bounds(outer_clip).expanded(margin);
+  Aabb2 reach = bounds(outer_clip).expanded(clearance + margin);
   {
     // Every constrained edge that meets O belongs to faces overlapping O's box: walk them.
     std::vector<FaceHandle> faces;
@@ -238,7 +241,7 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
       for (int i = 0; i < 3; ++i) {
         if (f->is_constrained(i)) {
           const VertexHandle a = f->vertex(Cdt::ccw(i)), b = f->vertex(Cdt::cw(i));
-          if (segment_near_region(xy(a), xy(b), outer_clip, margin)) dropped.emplace_back(a, b);
+          if (segment_near_region(xy(a), xy(b), outer_clip, clearance + margin)) dropped.emplace_back(a, b);
         }
         const FaceHandle n = f->neighbor(i);
         if (cdt_.is_infinite(n) || n->info() == walked) continue;
@@ -291,14 +294,16 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   auto is_own = [&own](VertexHandle v) { return std::binary_search(own.begin(), own.end(), &*v); };
   auto in_footprint = [&](const Vec2& p) { return s.contains(p) || distance_to_boundary(footprint, p) <= tiny; };
 
-  // Old vertices between I and O would bend the wall: removed.
+  // Old vertices between I and O would bend the wall, and those just outside O would crowd
+  // it: removed.
   collect_vertices(reach, vertex_scratch_);
   std::vector<VertexHandle> band;
   for (VertexHandle v : vertex_scratch_) {
     const Vec2 p = xy(v);
-    if (is_own(v) || v->info().border || !point_in_polygon(outer_clip, p)) continue;
-    if (distance_to_boundary(outer_clip, p) <= tiny || in_footprint(p) || has_constraints(v)) continue;
-    band.push_back(v);
+    if (is_own(v) || v->info().border || in_footprint(p) || has_constraints(v)) continue;
+    const double to_outer = distance_to_boundary(outer_clip, p);
+    if (to_outer <= tiny) continue;
+    if (point_in_polygon(outer_clip, p) || to_outer < clearance) band.push_back(v);
   }
   for (VertexHandle v : band) {
     remove_vertex(v);

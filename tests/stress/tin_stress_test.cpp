@@ -1,0 +1,207 @@
+// Stress tests of the TIN: the inputs that trip CGAL's constrained triangulation when
+// constraints touch or cross (CGAL issues 2999, 3263, 5439) -- crossing strokes, a thousand
+// stamps at one spot, collinear and near-duplicate contours, random strokes -- with check()
+// after every step. About 30 s in Release.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <numbers>
+#include <random>
+
+#include "common/height_field.hpp"
+#include "common/scene.hpp"
+#include "common/schedule.hpp"
+#include "tin/tin_terrain.hpp"
+
+namespace sb::tin::stress {
+namespace {
+
+const char* kScene = R"(
+[domain]
+size_m = [0.3, 0.3]
+[terrain]
+kind = "flat"
+height_m = 0.1
+[tool]
+shape = "disk"
+radius_m = 0.02
+depth_m = 0.01
+[stroke]
+path_m = [[0.05, 0.05], [0.25, 0.25]]
+spacing_m = 0.005
+)";
+
+const char* kDunes = R"(
+[domain]
+size_m = [0.3, 0.3]
+[terrain]
+kind = "dunes"
+height_m = 0.08
+amplitude_m = 0.03
+wavelength_m = 0.15
+seed = 3
+[tool]
+shape = "disk"
+radius_m = 0.015
+depth_m = 0.008
+[stroke]
+path_m = [[0.05, 0.05], [0.25, 0.25]]
+spacing_m = 0.005
+[tin]
+tolerance_m = 0.001
+)";
+
+struct Runner {
+  Scene scene;
+  std::unique_ptr<Terrain> terrain;
+  ErosionRule rule;
+  double volume_added = 0.0;
+  std::uint32_t generation = 0;
+
+  explicit Runner(const Scene& s)
+      : scene(s), terrain(make_tin_terrain(s, HeightField::from_scene(s))),
+        rule(ErosionRule::from(s.material, s.erosion.settle_tolerance_deg)) {}
+
+  // One step with check() after each phase; returns false (after reporting) on a problem.
+  bool step(ToolStamp st) {
+    st.generation = generation++;
+    terrain->stamp(st);
+    volume_added += st.is_pour() ? st.pour_volume_m3 : 0.0;
+    if (!ok("stamp")) return false;
+    terrain->erode(rule, ErosionBudget{scene.erosion.max_passes_per_step});
+    if (!ok("erode")) return false;
+    terrain->simplify(SimplifyParams{scene.tin.alpha_flat_deg});
+    return ok("simplify");
+  }
+  bool ok(const char* phase) const {
+    const IntegrityReport r = terrain->check();
+    EXPECT_TRUE(r.ok()) << "after " << phase << " of stamp " << generation - 1 << ": "
+                        << ::testing::PrintToString(r.problems);
+    return r.ok();
+  }
+  ToolStamp at(const ToolSpec& tool, Vec2 xy, double bottom_z, double heading) const {
+    ToolPose pose;
+    pose.xy = xy;
+    pose.bottom_z = bottom_z;
+    pose.heading_rad = heading;
+    return make_stamp(tool, pose, Vec2(std::cos(heading), std::sin(heading)), 0);
+  }
+  StampSchedule schedule(const Stroke& stroke) const {
+    const HeightField field = HeightField::from_scene(scene);
+    return make_schedule(scene.tool, stroke, [&field](const Vec2& p) { return field(p); });
+  }
+};
+
+TEST(TinStress, CrossingStrokes) {
+  for (const char* text : {kScene, kDunes}) {
+    for (bool conserve : {false, true}) {
+      Runner run(parse_scene(text, "stress", {std::string("tin.conserve_volume=") + (conserve ? "true" : "false")}));
+      const double v0 = run.terrain->volume();
+      // An X, a line through its centre, and the X again in the other direction.
+      const std::vector<std::vector<Vec2>> paths = {{{0.05, 0.05}, {0.25, 0.25}},
+                                                    {{0.05, 0.25}, {0.25, 0.05}},
+                                                    {{0.02, 0.15}, {0.28, 0.15}},
+                                                    {{0.25, 0.25}, {0.05, 0.05}},
+                                                    {{0.15, 0.02}, {0.15, 0.28}, {0.02, 0.15}}};
+      for (const auto& path : paths) {
+        Stroke stroke = run.scene.stroke;
+        stroke.path_m = path;
+        stroke.spacing_m = 0.008;
+        for (const ToolStamp& st : run.schedule(stroke).stamps) ASSERT_TRUE(run.step(st));
+      }
+      // Without compensation, Delaunay flips after splits and insertions change the volume
+      // by a few percent of the sand moved.
+      if (conserve) EXPECT_NEAR(run.terrain->volume(), v0, 1e-12 * v0);
+      else EXPECT_NEAR(run.terrain->volume(), v0, 0.05 * v0);
+      std::printf("crossing %s conserve %d: drift %.3g of the initial volume, %zu vertices\n",
+                  text == kScene ? "flat" : "dunes", conserve, (run.terrain->volume() - v0) / v0,
+                  run.terrain->stats().vertices);
+    }
+  }
+}
+
+TEST(TinStress, ThousandStampsAtOneSpot) {
+  Runner run(parse_scene(kScene, "stress", {"tin.conserve_volume=true"}));
+  const double v0 = run.terrain->volume();
+  const Vec2 spot(0.15, 0.15);
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int k = 0; k < 1000; ++k) {
+    // Same pose, then sub-snap and just-above-snap jitter, turning headings, deeper and
+    // shallower bottoms: contours land on, next to and across the previous ones.
+    Vec2 p = spot;
+    if (k % 4 == 1) p += 1e-9 * Vec2(u(rng), u(rng));
+    if (k % 4 == 2) p += 3e-6 * Vec2(u(rng), u(rng));
+    const double heading = k % 3 == 0 ? 0.0 : 0.05 * k;
+    const double bottom = 0.09 - 0.002 * (k % 5) + 0.001 * (k % 7);
+    ASSERT_TRUE(run.step(run.at(run.scene.tool, p, bottom, heading))) << "stamp " << k;
+  }
+  EXPECT_NEAR(run.terrain->volume(), v0, 1e-11 * v0);
+  EXPECT_LT(run.terrain->stats().vertices, 2000u) << "stamps at one spot do not pile up vertices";
+}
+
+TEST(TinStress, CollinearBoxContours) {
+  // Axis-aligned boxes stepped along their own edges: new contours collinear with old ones,
+  // passing exactly through old vertices.
+  Runner run(parse_scene(R"(
+[domain]
+size_m = [0.3, 0.3]
+[tool]
+shape = "box"
+size_m = [0.04, 0.02]
+depth_m = 0.01
+[stroke]
+path_m = [[0.05, 0.05]]
+)", "stress"));
+  for (int pass = 0; pass < 3; ++pass)
+    for (int k = 0; k < 40; ++k) {
+      const double x = 0.06 + 0.005 * k, y = 0.15 + 0.01 * (pass - 1);
+      ASSERT_TRUE(run.step(run.at(run.scene.tool, {x, y}, 0.09, 0.0)));
+    }
+  // And rotated by 90 degrees across them.
+  for (int k = 0; k < 30; ++k)
+    ASSERT_TRUE(run.step(run.at(run.scene.tool, {0.15, 0.05 + 0.007 * k}, 0.088, std::numbers::pi / 2)));
+}
+
+TEST(TinStress, RandomStrokes) {
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    Runner run(parse_scene(seed == 2 ? kDunes : kScene, "stress", {seed == 3 ? "tin.conserve_volume=true" : "tin.snap_m=1e-6"}));
+    const double v0 = run.terrain->volume();
+    for (int stroke = 0; stroke < 10; ++stroke) {
+      ToolSpec tool = run.scene.tool;
+      switch (static_cast<int>(u(rng) * 5)) {
+        case 0: tool.shape = ToolShape::Disk; tool.radius_m = 0.005 + 0.03 * u(rng); tool.sides = 3 + static_cast<int>(u(rng) * 60); break;
+        case 1: tool.shape = ToolShape::Box; tool.half_size_m = {0.003 + 0.02 * u(rng), 0.003 + 0.02 * u(rng)}; break;
+        case 2: tool.shape = ToolShape::Ellipse; tool.half_size_m = {0.005 + 0.02 * u(rng), 0.002 + 0.01 * u(rng)}; break;
+        case 3: tool.shape = ToolShape::Polygon; tool.polygon_m = {{-0.02, -0.01}, {0.02, -0.015}, {0.005, 0.0}, {0.02, 0.015}, {-0.02, 0.01}}; break;
+        default: tool.shape = ToolShape::Pour; tool.radius_m = 0.002 + 0.01 * u(rng); tool.pour_volume_m3 = 1e-7 + 1e-6 * u(rng); break;
+      }
+      if (u(rng) < 0.3) {
+        tool.profile = BottomProfile::SphereCap;
+        tool.sphere_radius_m = 0.02 + 0.05 * u(rng);
+      }
+      tool.rim.width_m = 0.002 + 0.02 * u(rng);
+      tool.rim.forward_bias = u(rng);
+      tool.depth_m = -0.005 + 0.02 * u(rng);  // sometimes above the surface
+      Stroke s;
+      // Random polylines, reaching over the border now and then.
+      for (int w = 0; w < 2 + static_cast<int>(u(rng) * 3); ++w)
+        s.path_m.emplace_back(-0.02 + 0.34 * u(rng), -0.02 + 0.34 * u(rng));
+      s.spacing_m = 0.002 + 0.01 * u(rng);
+      const HeightField field = HeightField::from_scene(run.scene);
+      const StampSchedule schedule = make_schedule(tool, s, [&field](const Vec2& p) { return field(p); });
+      for (std::size_t k = 0; k < schedule.stamps.size() && k < 30; ++k)
+        ASSERT_TRUE(run.step(schedule.stamps[k])) << "seed " << seed << " stroke " << stroke;
+    }
+    const double drift = run.terrain->volume() - v0 - run.volume_added;
+    if (seed == 3) EXPECT_NEAR(drift, 0.0, 1e-11 * v0);
+    else EXPECT_NEAR(drift, 0.0, 0.05 * v0);
+    std::printf("random seed %llu: drift %.3g of the initial volume, %zu vertices, %u stamps\n",
+                static_cast<unsigned long long>(seed), drift / v0, run.terrain->stats().vertices, run.generation);
+  }
+}
+
+}  // namespace
+}  // namespace sb::tin::stress
