@@ -27,6 +27,9 @@ struct Case {
   std::vector<std::string> overrides;
 };
 
+// gtest prints the case by name rather than as bytes.
+void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
+
 const std::vector<Case>& cases() {
   static const std::vector<Case> all = {
       {"flat_stroke-tin", "flat_stroke.toml", "tin", {}},
