@@ -10,34 +10,19 @@
 
 namespace sb::tin::detail {
 
-namespace {
-
-// Neighbours of v with their heights, distances and areas; returns v's own area.
-double gather(const Cdt& cdt, VertexHandle v, std::vector<VertexHandle>& handles,
-              std::vector<ErosionNeighbour>& nbrs) {
-  handles.clear();
-  nbrs.clear();
-  double area = 0.0;
-  auto fc = cdt.incident_faces(v), fdone = fc;
+double TinTerrain::gather_neighbours(VertexHandle v) {
+  vertex_scratch_.clear();
+  nbr_scratch_.clear();
+  const Vec2 p = xy(v);
+  auto c = cdt_.incident_vertices(v), done = c;
   do {
-    if (!cdt.is_infinite(fc)) area += face_area(fc);
-  } while (++fc != fdone);
-  auto c = cdt.incident_vertices(v), done = c;
-  do {
-    if (cdt.is_infinite(c)) continue;
+    if (cdt_.is_infinite(c)) continue;
     const VertexHandle w = c;
-    double aw = 0.0;
-    auto wc = cdt.incident_faces(w), wdone = wc;
-    do {
-      if (!cdt.is_infinite(wc)) aw += face_area(wc);
-    } while (++wc != wdone);
-    handles.push_back(w);
-    nbrs.push_back({w->point().z(), (xy(w) - xy(v)).norm(), aw / 3.0});
+    vertex_scratch_.push_back(w);
+    nbr_scratch_.push_back({w->point().z(), (xy(w) - p).norm(), cached_area(w)});
   } while (++c != done);
-  return area / 3.0;
+  return cached_area(v);
 }
-
-}  // namespace
 
 VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* inserted) {
   const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
@@ -57,7 +42,7 @@ VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* insert
 
 std::size_t TinTerrain::refine_around(VertexHandle v) {
   std::size_t splits = 0;
-  for (int guard = 0; guard < 64; ++guard) {
+  for (int guard = 0; guard < 64 && has_long_edges(v); ++guard) {
     VertexHandle far;
     double longest = refine_m_;
     auto c = cdt_.incident_vertices(v), done = c;
@@ -92,7 +77,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& bu
       if (report.updates >= budget.max_updates) break;
       if (v->info().erosion_slot == kNoSlot) continue;
       ++report.updates;
-      double area = gather(cdt_, v, vertex_scratch_, nbr_scratch_);
+      double area = gather_neighbours(v);
       transfer_scratch_.resize(nbr_scratch_.size());
       double total = erosion_transfers(v->point().z(), area, nbr_scratch_, rule, transfer_scratch_);
       // Sand moving between vertices with long edges would spread over far-reaching
@@ -102,7 +87,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& bu
         for (std::size_t k = 0; k < nbr_scratch_.size(); ++k)
           if (transfer_scratch_[k] > 0.0) splits += refine_around(vertex_scratch_[k]);
         if (splits == 0) break;
-        area = gather(cdt_, v, vertex_scratch_, nbr_scratch_);
+        area = gather_neighbours(v);
         transfer_scratch_.resize(nbr_scratch_.size());
         total = erosion_transfers(v->point().z(), area, nbr_scratch_, rule, transfer_scratch_);
       }

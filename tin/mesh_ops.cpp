@@ -170,6 +170,8 @@ VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted
   const VertexHandle v = cdt_.insert(Point(p.x(), p.y(), z), loc.type, loc.face, loc.index);
   v->info() = VertexInfo{};
   v->info().border = on_border(p) ? 1 : 0;
+  // Every face the insertion (and its flips) changed is incident to v now.
+  forget_star(v);
   if (splits_constraint) {
     generations_[EdgeKey(e1, v)] = generation;
     generations_[EdgeKey(v, e2)] = generation;
@@ -192,7 +194,17 @@ void TinTerrain::remove_vertex(VertexHandle v) {
       }
     } while (++c != done);
   }
+  link_scratch_.clear();
+  auto c = cdt_.incident_vertices(v), done = c;
+  do {
+    if (!cdt_.is_infinite(c)) link_scratch_.push_back(c);
+  } while (++c != done);
   cdt_.remove(v);
+  // The hole is retriangulated from its boundary, the removed vertex's neighbours.
+  for (VertexHandle w : link_scratch_) {
+    w->info().area = -1.0;
+    w->info().short_edges = 0;
+  }
 }
 
 void TinTerrain::constrain(VertexHandle a, VertexHandle b, std::uint32_t generation) {
@@ -243,6 +255,34 @@ double TinTerrain::vertex_area(VertexHandle v) const {
     if (!cdt_.is_infinite(c)) area += face_area(c);
   } while (++c != done);
   return area / 3.0;
+}
+
+double TinTerrain::cached_area(VertexHandle v) const {
+  VertexInfo& in = v->info();
+  if (in.area < 0.0) in.area = vertex_area(v);
+  return in.area;
+}
+
+void TinTerrain::forget_star(VertexHandle v) {
+  v->info().area = -1.0;
+  v->info().short_edges = 0;
+  auto c = cdt_.incident_vertices(v), done = c;
+  do {
+    if (cdt_.is_infinite(c)) continue;
+    c->info().area = -1.0;
+    c->info().short_edges = 0;
+  } while (++c != done);
+}
+
+bool TinTerrain::has_long_edges(VertexHandle v) const {
+  if (v->info().short_edges) return false;
+  const double limit2 = refine_m_ * refine_m_;
+  auto c = cdt_.incident_vertices(v), done = c;
+  do {
+    if (!cdt_.is_infinite(c) && (xy(c) - xy(v)).squaredNorm() > limit2) return true;
+  } while (++c != done);
+  v->info().short_edges = 1;
+  return false;
 }
 
 void TinTerrain::set_z(VertexHandle v, double z) {

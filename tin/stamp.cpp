@@ -375,6 +375,11 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   std::vector<VertexHandle> region_vertices;
   const CaptureResult measured = end_capture(capture, &region_vertices);
   const double surface_change = measured.delta() + lowered_volume;
+  // Constraint changes retriangulate inside the region, beyond the inserted vertices' stars.
+  for (VertexHandle v : region_vertices) {
+    v->info().area = -1.0;
+    v->info().short_edges = 0;
+  }
 
   // 1d (cont.): the displaced volume goes to the rim band, weighted by the common rule. The
   // band's vertices first get short edges (refine_around), so the sand stays in the band.

@@ -10,7 +10,7 @@
 namespace sb::tin::detail {
 
 // The sizes tin_terrain.hpp documents.
-static_assert(sizeof(Tds::Vertex) == 48, "vertex: point 24 + face handle 8 + VertexInfo 16");
+static_assert(sizeof(Tds::Vertex) == 56, "vertex: point 24 + face handle 8 + VertexInfo 24");
 static_assert(sizeof(Tds::Face) == 56, "face: 3 vertices, 3 neighbours, TDS flag, 3 constraint flags, mark");
 
 namespace {
@@ -59,7 +59,8 @@ ModelStats TinTerrain::stats() const {
   bytes += (generations_.bucket_count() > 1 ? generations_.bucket_count() * sizeof(void*) : 0) +
            generations_.size() * node;
   bytes += vector_bytes(erosion_list_) + vector_bytes(simplify_list_) + vector_bytes(nbr_scratch_) +
-           vector_bytes(transfer_scratch_) + vector_bytes(vertex_scratch_) + vector_bytes(face_scratch_);
+           vector_bytes(transfer_scratch_) + vector_bytes(vertex_scratch_) + vector_bytes(face_scratch_) +
+           vector_bytes(link_scratch_);
   st.bytes = bytes;
   return st;
 }
@@ -143,6 +144,14 @@ IntegrityReport TinTerrain::check() const {
     if (!box_.contains(xy(p))) problem("a vertex lies outside the domain");
     if ((v->info().border != 0) != on_border(xy(p))) problem("a vertex's border flag is wrong");
     const VertexInfo& in = v->info();
+    if (in.area >= 0.0 && std::abs(in.area - vertex_area(v)) > 1e-12 * in.area)
+      problem("a vertex's cached area is stale");
+    if (in.short_edges) {
+      auto c = cdt_.incident_vertices(v), done = c;
+      do {
+        if (!cdt_.is_infinite(c) && (xy(c) - xy(p)).norm() > refine_m_) problem("a vertex's short-edge flag is stale");
+      } while (++c != done);
+    }
     if (in.erosion_slot != kNoSlot) {
       ++in_erosion;
       if (in.erosion_slot >= erosion_list_.size() || erosion_list_[in.erosion_slot] != VertexHandle(v))

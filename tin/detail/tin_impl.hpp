@@ -21,14 +21,17 @@ namespace sb::tin::detail {
 
 inline constexpr std::uint32_t kNoSlot = 0xffffffffu;
 
-// Per-vertex bookkeeping, 16 bytes.
+// Per-vertex bookkeeping, 24 bytes.
 struct VertexInfo {
+  // Barycentric area (one third of the incident triangles' areas), cached for erosion, which
+  // needs it for every neighbour of every vertex it visits; < 0 when the star changed since.
+  double area = -1.0;
   std::uint32_t erosion_slot = kNoSlot;   // index in L_e, or kNoSlot
   std::uint32_t simplify_slot = kNoSlot;  // index in L_r, or kNoSlot
   std::uint32_t mark = 0;                 // traversal epoch (see TinTerrain::next_vertex_epoch)
   std::uint16_t idle = 0;                 // erosion visits without a transfer
   std::uint8_t border = 0;                // on the domain boundary: never removed
-  std::uint8_t unused = 0;
+  std::uint8_t short_edges = 0;           // 1: no edge longer than refine_m_ (valid with area)
 };
 
 // A face's traversal epoch (or, while building, its sample bucket + 1). A class so that new
@@ -143,6 +146,12 @@ class TinTerrain final : public Terrain {
   bool has_constraints(VertexHandle v) const;
   double vertex_area(VertexHandle v) const;
   void set_z(VertexHandle v, double z);
+  // The cached area (computed when stale); and forgetting the caches of v and its neighbours,
+  // whose stars change when v's does. Every change of the triangulation goes through
+  // insert_point, remove_vertex, or a stamp, which forget the caches of the region they touched.
+  double cached_area(VertexHandle v) const;
+  void forget_star(VertexHandle v);
+  bool has_long_edges(VertexHandle v) const;
   Capture begin_capture(const Aabb2& box);
   CaptureResult end_capture(Capture& c, std::vector<VertexHandle>* region_vertices = nullptr);
   // Vertices inside `box` (a traversal of the faces overlapping it).
@@ -160,6 +169,9 @@ class TinTerrain final : public Terrain {
   // erosion.cpp: splits edge (a, b) at its middle (volume change measured, and compensated
   // under tin.conserve_volume); returns the vertex there.
   VertexHandle split_edge(VertexHandle a, VertexHandle b, bool* inserted);
+  // v's neighbours (vertex_scratch_) with heights, distances and areas (nbr_scratch_); returns
+  // v's area.
+  double gather_neighbours(VertexHandle v);
   // Splits v's edges longer than refine_m_ until none is; returns the number of splits.
   std::size_t refine_around(VertexHandle v);
   // build.cpp
@@ -193,6 +205,7 @@ class TinTerrain final : public Terrain {
   std::vector<double> transfer_scratch_;
   std::vector<VertexHandle> vertex_scratch_;
   std::vector<FaceHandle> face_scratch_;
+  std::vector<VertexHandle> link_scratch_;
 };
 
 // Area of a finite face projected on the xy plane (positive: faces are counter-clockwise).
