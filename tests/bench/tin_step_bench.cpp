@@ -1,0 +1,133 @@
+// One simulation step of the TIN (stamp + erosion + simplification) against the model size
+// N = 10^3 ... 10^6 vertices, where the paper measured O(N^1.5).
+//
+// The TIN is built (outside the timed loop) from N jittered points at a fixed 6 mm spacing
+// over a domain that grows with N, on a plane tilted by 3.4 degrees (so no vertex is "flat")
+// with small bumps. The jitter and heights are functions of the point's offset from the
+// domain's centre, so every N has the very same terrain around the centre, where a 1.5 cm
+// disk stamps 12 poses on a 3 cm circle, round and round: each iteration does the same work
+// at every N, and any growth with N comes from global costs (walks, lists, containers).
+//
+//   build/<dir>/tests/tin_step_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+//
+// The cost per step should not grow with N: fit log(time) against log(N) (slope < 0.15).
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <numbers>
+
+#include "common/erosion.hpp"
+#include "common/scene.hpp"
+#include "tin/tin_terrain.hpp"
+
+namespace {
+
+constexpr double kSpacing = 0.006;
+constexpr double kToolRadius = 0.015;
+constexpr double kDepth = 0.005;
+constexpr double kLoopRadius = 0.03;
+constexpr int kPoses = 12;
+
+// A reproducible value in [0, 1) from two integers (splitmix64).
+double hash01(std::int64_t i, std::int64_t j, std::uint64_t salt) {
+  std::uint64_t x = static_cast<std::uint64_t>(i) * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint64_t>(j) * 0xC2B2AE3D27D4EB4Full ^ salt;
+  x ^= x >> 30;
+  x *= 0xBF58476D1CE4E5B9ull;
+  x ^= x >> 27;
+  x *= 0x94D049BB133111EBull;
+  x ^= x >> 31;
+  return static_cast<double>(x >> 11) * 0x1.0p-53;
+}
+
+// Heights relative to the centre: a 3.4-degree plane plus 1 mm bumps.
+double surface(const sb::Vec2& d) {
+  return 1.0 + 0.05 * d.x() + 0.03 * d.y() + 0.001 * std::sin(60.0 * d.x()) * std::cos(50.0 * d.y());
+}
+
+struct Setup {
+  sb::Scene scene;
+  std::unique_ptr<sb::Terrain> terrain;
+  sb::Vec2 centre;
+  sb::ErosionRule rule;
+};
+
+std::unique_ptr<Setup> build(std::int64_t n, bool conserve) {
+  auto s = std::make_unique<Setup>();
+  const auto side = static_cast<std::int64_t>(std::llround(std::sqrt(static_cast<double>(n))));
+  const double size = kSpacing * static_cast<double>(side);
+  const std::string text = "[domain]\nsize_m = [" + std::to_string(size) + ", " + std::to_string(size) +
+                           "]\n[tool]\nshape = \"disk\"\nradius_m = " + std::to_string(kToolRadius) +
+                           "\ndepth_m = " + std::to_string(kDepth) + "\n[stroke]\npath_m = [[0.0, 0.0]]\n[tin]\n" +
+                           "conserve_volume = " + (conserve ? "true" : "false") + "\n";
+  s->scene = sb::parse_scene(text, "tin_step_bench");
+  s->centre = sb::Vec2(size / 2, size / 2);
+  s->rule = sb::ErosionRule::from(s->scene.material, s->scene.erosion.settle_tolerance_deg);
+  std::vector<sb::Vec3> points;
+  points.reserve(static_cast<std::size_t>(side * side));
+  const std::int64_t mid = side / 2;
+  for (std::int64_t j = 0; j < side; ++j)
+    for (std::int64_t i = 0; i < side; ++i) {
+      const sb::Vec2 p((static_cast<double>(i) + 0.1 + 0.8 * hash01(i - mid, j - mid, 1)) * kSpacing,
+                       (static_cast<double>(j) + 0.1 + 0.8 * hash01(i - mid, j - mid, 2)) * kSpacing);
+      points.emplace_back(p.x(), p.y(), surface(p - s->centre));
+    }
+  s->terrain = sb::tin::make_tin_terrain_from_points(s->scene, points);
+  return s;
+}
+
+sb::ToolStamp pose(const Setup& s, int k) {
+  const double a = 2.0 * std::numbers::pi * (k % kPoses) / kPoses;
+  const sb::Vec2 offset = kLoopRadius * sb::Vec2(std::cos(a), std::sin(a));
+  const sb::Vec2 motion(-std::sin(a), std::cos(a));
+  sb::ToolPose p;
+  p.xy = s.centre + offset;
+  p.bottom_z = surface(offset) - kDepth;
+  p.heading_rad = std::atan2(motion.y(), motion.x());
+  return sb::make_stamp(s.scene.tool, p, motion, static_cast<std::uint32_t>(k));
+}
+
+void step(Setup& s, int k) {
+  s.terrain->stamp(pose(s, k));
+  s.terrain->erode(s.rule, sb::ErosionBudget{s.scene.erosion.max_passes_per_step});
+  s.terrain->simplify(sb::SimplifyParams{s.scene.tin.alpha_flat_deg});
+}
+
+// Built once per (N, conserve) and kept: construction is not what is measured.
+Setup& setup(std::int64_t n, bool conserve) {
+  static std::map<std::pair<std::int64_t, bool>, std::unique_ptr<Setup>> cache;
+  auto& slot = cache[{n, conserve}];
+  if (!slot) {
+    slot = build(n, conserve);
+    for (int k = 0; k < 2 * kPoses; ++k) step(*slot, k);  // warm up: the loop's steady state
+  }
+  return *slot;
+}
+
+void BM_TinStep(benchmark::State& state) {
+  Setup& s = setup(state.range(0), state.range(1) != 0);
+  const sb::ModelStats before = s.terrain->stats();
+  int k = 0;
+  for (auto _ : state) step(s, k++);
+  const sb::ModelStats after = s.terrain->stats();
+  state.counters["vertices"] = static_cast<double>(after.vertices);
+  state.counters["walk_steps_per_step"] =
+      static_cast<double>(after.walk_steps - before.walk_steps) / static_cast<double>(k);
+  state.counters["active"] = static_cast<double>(after.active);
+  state.counters["MB"] = static_cast<double>(after.bytes) / 1e6;
+}
+
+BENCHMARK(BM_TinStep)
+    ->ArgNames({"N", "conserve"})
+    ->Args({1000, 0})
+    ->Args({10000, 0})
+    ->Args({100000, 0})
+    ->Args({1000000, 0})
+    ->Args({10000, 1})
+    ->Args({1000000, 1})
+    ->Iterations(240)
+    ->Unit(benchmark::kMicrosecond);
+
+}  // namespace
