@@ -1,6 +1,7 @@
 #include "grid/grid_stamp.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace sb::grid {
 
@@ -23,7 +24,9 @@ std::vector<Deposit> widened_rim(const GridLayout& layout, const ToolStamp& s) {
   const Aabb2 footprint_box = bounds(s.footprint);
   const Aabb2 grid_box = layout.box();
   std::vector<Deposit> rim;
-  for (double extra = layout.diagonal();; extra *= 2.0) {
+  // 64 doublings outgrow any domain; the bound only guards against non-finite input.
+  double extra = layout.diagonal();
+  for (int round = 0; round < 64; ++round, extra *= 2.0) {
     const double width = std::max(0.0, s.rim.width_m) + extra;
     const Aabb2 window = footprint_box.expanded(width);
     const NodeRange r = layout.nodes_in(window);
@@ -41,6 +44,7 @@ std::vector<Deposit> widened_rim(const GridLayout& layout, const ToolStamp& s) {
     const bool covers_grid = window.contains(grid_box.lo) && window.contains(grid_box.hi);
     if (covers_grid && !any_outside) return rim;
   }
+  return rim;
 }
 
 // Two circles about the footprint's vertex centroid that classify most nodes of the window
@@ -128,6 +132,7 @@ StampReport cut_and_push(HeightGrid<Real>& grid, const ToolStamp& s, std::vector
 template <class Real>
 StampReport pour(HeightGrid<Real>& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed) {
   const GridLayout& layout = grid.layout();
+  if (!s.pose.xy.allFinite() || !std::isfinite(s.pour_volume_m3)) return {};
   std::vector<std::uint32_t> nodes;
   const NodeRange r = layout.nodes_in(s.influence_bounds());
   const double r2 = s.pour_radius_m * s.pour_radius_m;

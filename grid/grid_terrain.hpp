@@ -24,7 +24,8 @@
 //   construction                O(n) evaluations of the initial surface
 //   height(p)                   O(1)
 //   sample(raster)              O(raster points)
-//   stamp                       O(w * v); pour O(nodes within its radius)
+//   stamp                       O(w), plus O(v) per node near the footprint's boundary
+//                               or in the rim band; pour O(nodes within its radius)
 //   erode                       O(passes * a * stencil); never the whole grid
 //   simplify                    O(1), nothing to simplify on a grid
 //   volume, max_slope_deg,
