@@ -3,6 +3,8 @@
 #include <pthread.h>
 #include <sched.h>
 #include <sys/prctl.h>
+#include <sys/resource.h>
+#include <unistd.h>
 #include <time.h>
 
 #include <cerrno>
@@ -33,7 +35,9 @@ bool request_realtime(int priority) {
   ::prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
   sched_param sp{};
   sp.sched_priority = priority;
-  return ::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &sp) == 0;
+  if (::pthread_setschedparam(::pthread_self(), SCHED_FIFO, &sp) == 0) return true;
+  ::setpriority(PRIO_PROCESS, static_cast<id_t>(::gettid()), -15);  // second best, when allowed
+  return false;
 }
 
 }  // namespace sb::haptics

@@ -11,7 +11,7 @@ using ServoClock = std::chrono::steady_clock;
 
 void wait_until(ServoClock::time_point deadline, std::chrono::nanoseconds spin);
 // SCHED_FIFO at a low real-time priority plus a 1 us timer slack for the calling thread.
-// Returns false (and changes nothing) when the system does not allow it.
+// Returns false when the system does not allow it (the thread then gets nice -15 if it may).
 bool request_realtime(int priority = 20);
 
 }  // namespace sb::haptics
