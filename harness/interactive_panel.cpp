@@ -83,9 +83,12 @@ PanelActions draw_panel(const PanelInput& in, SimControls& c, PanelState& state,
                 100.0 * sv.model.contact_fraction, sv.clamped ? "  CLAMPED" : "");
     const Vec3& p = sv.device.position_m;
     ImGui::Text("tool (%.3f, %.3f, %.3f) m%s", p.x(), p.y(), p.z(), sv.device.valid ? "" : "  no pose");
-    if (in.mouse)
+    if (in.mouse) {
+      ImGui::PushTextWrapPos(0.0f);
       ImGui::TextDisabled("mouse: depth %.1f mm (wheel, Up/Down); right-drag orbits, ctrl+wheel zooms",
                           1e3 * in.mouse_depth_m);
+      ImGui::PopTextWrapPos();
+    }
   }
 
   if (ImGui::CollapsingHeader("Material", ImGuiTreeNodeFlags_DefaultOpen)) {
