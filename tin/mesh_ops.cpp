@@ -392,7 +392,6 @@ CaptureResult TinTerrain::end_capture(Capture& c, std::vector<VertexHandle>* reg
     ++capture_mismatches_;
     r.volume_after = r.volume_before;  // unknown: report no change rather than a wrong one
   }
-  retriangulation_volume_m3_ += r.delta();
   return r;
 }
 

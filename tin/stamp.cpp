@@ -38,12 +38,17 @@ std::vector<Vec2> offset_polygon(const std::vector<Vec2>& poly, double gap) {
   return out;
 }
 
+// Convex and simple: no right turn, and the turns add up to one full turn (a pentagram
+// turns left at every corner, but twice around).
 bool is_convex(const std::vector<Vec2>& poly) {
   const std::size_t n = poly.size();
+  double turning = 0.0;
   for (std::size_t i = 0; i < n; ++i) {
-    if (cross2(poly[(i + 1) % n] - poly[i], poly[(i + 2) % n] - poly[(i + 1) % n]) < 0.0) return false;
+    const Vec2 a = poly[(i + 1) % n] - poly[i], b = poly[(i + 2) % n] - poly[(i + 1) % n];
+    if (cross2(a, b) < 0.0) return false;
+    turning += std::atan2(cross2(a, b), a.dot(b));
   }
-  return true;
+  return std::abs(turning - 2.0 * std::numbers::pi) < 1e-6;
 }
 
 // Sutherland-Hodgman clipping of a polygon to the box. Points on the box's sides are exact.
@@ -122,13 +127,16 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
     throw InputError("stamp: the pose, rim and motion must be finite");
   if (s.profile == BottomProfile::SphereCap && !(s.sphere_radius_m > 0.0))
     throw InputError("stamp: a sphere-cap tool needs a positive sphere radius");
-  const std::vector<Vec2> footprint = make_ccw(s.footprint);
-  const double area = std::abs(signed_area(footprint));
-  if (!(area > 0.0)) throw InputError("stamp: the footprint has zero area");
-
   StampReport report;
   const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
   const double tiny = 1e-12 * extent;
+  std::vector<Vec2> footprint = make_ccw(s.footprint);
+  drop_near_duplicates(footprint, tiny);
+  const double area = std::abs(signed_area(footprint));
+  if (footprint.size() < 3 || !(area > 0.0)) throw InputError("stamp: the footprint has zero area");
+  // Its edges become constraints, which must not cross.
+  if (!is_convex(footprint) && !is_simple_polygon(footprint))
+    throw InputError("stamp: the footprint must be a simple polygon (its edges cross)");
   const double snap = spec_.snap_m;
   const double margin = 4.0 * snap + 1e-9 * extent;
   const double radius = std::sqrt(area / std::numbers::pi);

@@ -20,6 +20,7 @@
 #include <numbers>
 
 #include "common/erosion.hpp"
+#include "common/metrics.hpp"
 #include "common/scene.hpp"
 #include "tin/tin_terrain.hpp"
 
@@ -89,10 +90,24 @@ sb::ToolStamp pose(const Setup& s, int k) {
   return sb::make_stamp(s.scene.tool, p, motion, static_cast<std::uint32_t>(k));
 }
 
-void step(Setup& s, int k) {
+struct PhaseTimes {
+  double stamp_s = 0.0, erode_s = 0.0, simplify_s = 0.0;
+  std::size_t updates = 0;
+};
+
+void step(Setup& s, int k, PhaseTimes* times = nullptr) {
+  sb::Stopwatch watch;
   s.terrain->stamp(pose(s, k));
-  s.terrain->erode(s.rule, sb::ErosionBudget{s.scene.erosion.max_passes_per_step});
+  const double t1 = watch.seconds();
+  const sb::ErosionReport r = s.terrain->erode(s.rule, sb::ErosionBudget{s.scene.erosion.max_passes_per_step});
+  const double t2 = watch.seconds();
   s.terrain->simplify(sb::SimplifyParams{s.scene.tin.alpha_flat_deg});
+  if (times) {
+    times->stamp_s += t1;
+    times->erode_s += t2 - t1;
+    times->simplify_s += watch.seconds() - t2;
+    times->updates += r.updates;
+  }
 }
 
 // Built once per (N, conserve) and kept: construction is not what is measured.
@@ -110,8 +125,13 @@ void BM_TinStep(benchmark::State& state) {
   Setup& s = setup(state.range(0), state.range(1) != 0);
   const sb::ModelStats before = s.terrain->stats();
   int k = 0;
-  for (auto _ : state) step(s, k++);
+  PhaseTimes times;
+  for (auto _ : state) step(s, k++, &times);
   const sb::ModelStats after = s.terrain->stats();
+  state.counters["stamp_us"] = 1e6 * times.stamp_s / k;
+  state.counters["erode_us"] = 1e6 * times.erode_s / k;
+  state.counters["simplify_us"] = 1e6 * times.simplify_s / k;
+  state.counters["erosion_updates"] = static_cast<double>(times.updates) / k;
   state.counters["vertices"] = static_cast<double>(after.vertices);
   state.counters["walk_steps_per_step"] =
       static_cast<double>(after.walk_steps - before.walk_steps) / static_cast<double>(k);

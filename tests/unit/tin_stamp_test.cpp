@@ -221,11 +221,35 @@ TEST(TinStamp, DegenerateStampsAreRefused) {
   // Nothing was changed by the refused stamps.
   EXPECT_EQ(t->stats().vertices, 4u);
   SB_EXPECT_TIN_OK(*t);
+  ToolStamp bowtie = st;
+  bowtie.footprint = {{0.23, 0.23}, {0.27, 0.27}, {0.27, 0.23}, {0.23, 0.27}};
+  EXPECT_THROW(t->stamp(bowtie), InputError);
+  ToolStamp pentagram = st;
+  pentagram.footprint.clear();
+  for (int k = 0; k < 5; ++k) {
+    const double a = 2.0 * std::numbers::pi * (2 * k) / 5.0;
+    pentagram.footprint.emplace_back(0.25 + 0.02 * std::cos(a), 0.25 + 0.02 * std::sin(a));
+  }
+  EXPECT_THROW(t->stamp(pentagram), InputError);
+  ToolStamp repeated = st;
+  repeated.footprint.insert(repeated.footprint.begin() + 3, 3, repeated.footprint[3]);
+  t->stamp(repeated);
+  SB_EXPECT_TIN_OK(*t);
   // A clockwise footprint is accepted (made counter-clockwise).
   ToolStamp cw = st;
   std::reverse(cw.footprint.begin(), cw.footprint.end());
   t->stamp(cw);
   SB_EXPECT_TIN_OK(*t);
+}
+
+TEST(TinStamp, AFootprintCoveringTheWholeDomain) {
+  const Scene s = scene(kFlatScene, {"tool.radius_m=0.6"});
+  auto t = make(s);
+  const StampReport r = t->stamp(stamp_at(s, {0.25, 0.25}, 0.09));
+  SB_EXPECT_TIN_OK(*t);
+  EXPECT_NEAR(t->volume(), 0.025, 1e-15) << "the sand has nowhere else to go: it stays";
+  EXPECT_GT(r.volume_removed_m3, 0.0);
+  EXPECT_EQ(t->stats().constrained_edges, 0u);
 }
 
 TEST(TinStamp, NonConvexPolygonTool) {

@@ -198,7 +198,6 @@ class TinTerrain final : public Terrain {
   std::uint32_t face_epoch_ = 0;
   std::uint32_t vertex_epoch_ = 0;
   std::size_t capture_mismatches_ = 0;  // regions whose area changed: a broken assumption
-  double retriangulation_volume_m3_ = 0.0;  // volume changes measured by captures, summed
 
   // Scratch reused across calls (counted in stats().bytes).
   std::vector<ErosionNeighbour> nbr_scratch_;
