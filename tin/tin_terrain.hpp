@@ -20,12 +20,13 @@
 //                     sorted insertion (about 2 s for 10^6 points)
 //   height(p)         one walk from the last located face: O(1) for nearby queries
 //   stamp             O(k): contours inserted, old constraints dropped, constraints enforced,
-//                     vertices removed, the rim refined (about 0.5 ms for a 1.5 cm disk)
-//   erode             O(|L_e| * degree) per pass (vertex areas are cached); an edge split is
-//                     O(1) (about 0.35 us per vertex visit)
+//                     vertices removed, the rim refined (about 0.6 ms for a 1.5 cm disk)
+//   erode             O(|L_e| * degree) per pass (vertex areas are cached), about 0.25 us
+//                     per vertex visit; an edge split is O(1)
 //   simplify          detect O(|L_r| * degree); removal O(degree) per vertex
-//   one step          stamp + 4 erosion passes + simplify: about 1.6 ms at any n from 10^3
-//                     to 10^6 (tests/bench/tin_step_bench.cpp), where the paper had O(n^1.5)
+//   one step          stamp + 4 erosion passes + simplify: 1.7 to 2.1 ms at every n from 10^3
+//                     to 10^6, log-log slope -0.01 (tests/bench/tin_step_bench.cpp), where
+//                     the paper measured O(n^1.5)
 //   volume, mesh, check, max_slope_deg: O(n); sample: O(raster points), walking row by row
 // Volume: stamps, erosion and simplification conserve volume except where the Delaunay
 // triangulation changes under a non-planar surface (flips after insertions and edge splits,
