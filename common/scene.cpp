@@ -322,6 +322,8 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   s.tin.conserve_volume = f.boolean("tin.conserve_volume", false);
   s.tin.contour_subdivision_m = f.number("tin.contour_subdivision_m", 0.0, closed(0.0, extent));
   s.tin.snap_m = f.number("tin.snap_m", 1e-6, closed(0.0, 1e-2));
+  s.tin.initial_points = f.integer("tin.initial_points", 0, 0, 20000000);
+  s.tin.initial_jitter = f.number("tin.initial_jitter", 0.5, closed(0.0, 0.9));
   s.tin.contour_gap_m = f.number("tin.contour_gap_m", 0.0, closed(0.0, extent));
   s.tin.refine_m = f.number("tin.refine_m", 0.0, closed(0.0, extent));
 

@@ -49,6 +49,10 @@ struct TinSpec {
   bool conserve_volume = false;       // compensate simplification and flip volume changes
   double contour_subdivision_m = 0.0; // outer contour subdivision step; 0: tool polygon only
   double snap_m = 1e-6;               // points closer than this to a vertex reuse it
+  // A TIN of about this many vertices from the start (a jittered lattice with heights from
+  // the terrain), as in the paper's experiments; 0: as few as the terrain needs.
+  long long initial_points = 0;
+  double initial_jitter = 0.5;        // lattice jitter, fraction of a cell; 0: exact lattice
   double contour_gap_m = 0.0;         // outer-to-inner contour distance; 0: 5% of the tool size
   double refine_m = 0.0;              // erosion splits edges longer than this that sand flows
                                       // across; 0: half the tool (or pour) radius

@@ -8,6 +8,7 @@
 #include <queue>
 
 #include "common/input_error.hpp"
+#include "common/point_sets.hpp"
 #include "tin/detail/tin_impl.hpp"
 #include "tin/tin_terrain.hpp"
 
@@ -240,6 +241,14 @@ void TinTerrain::build_from_points(const std::vector<Vec3>& points) {
 }  // namespace detail
 
 std::unique_ptr<Terrain> make_tin_terrain(const Scene& scene, const HeightField& initial) {
+  if (scene.tin.initial_points > 0) {
+    // The paper's experiments: a TIN of N vertices from the start.
+    std::vector<Vec3> points;
+    for (const Vec2& p : jittered_lattice(scene.domain, static_cast<std::size_t>(scene.tin.initial_points),
+                                          scene.tin.initial_jitter, static_cast<std::uint64_t>(scene.terrain.seed)))
+      points.emplace_back(p.x(), p.y(), initial(p));
+    return make_tin_terrain_from_points(scene, points);
+  }
   auto t = std::make_unique<detail::TinTerrain>(scene);
   t->build_from_field(initial);
   return t;

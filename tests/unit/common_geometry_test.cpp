@@ -39,3 +39,22 @@ TEST(Metrics, PercentileInterpolates) {
 
 }  // namespace
 }  // namespace sb
+
+#include "common/point_sets.hpp"
+
+namespace sb {
+namespace {
+
+TEST(PointSets, JitteredLatticeCoversTheDomainDeterministically) {
+  DomainSpec d{{1e6, 2.0}, {0.7, 0.35}};
+  const auto a = jittered_lattice(d, 200, 0.5, 3), b = jittered_lattice(d, 200, 0.5, 3);
+  EXPECT_EQ(a, b);
+  EXPECT_NEAR(static_cast<double>(a.size()), 200.0, 20.0);
+  for (const Vec2& p : a) EXPECT_TRUE(d.box().contains(p));
+  const auto exact = jittered_lattice(d, 200, 0.0, 3);
+  EXPECT_EQ(exact.front(), d.origin_m);
+  EXPECT_NE(a[30], exact[30]);  // an interior point moved
+}
+
+}  // namespace
+}  // namespace sb
