@@ -54,6 +54,10 @@ def run(ctx):
     growth = "not reproduced" if slopes["removal"] < 1.2 else "reproduced"
     text = f"""## Figure 7: time of each part against TIN size
 
+Our parts: *tool* is the whole stamp (steps 1a-1f, including the removal of the redundant inner vertices at tool
+level, which the paper counts as vertex removal), *erosion* is step 2, *detection* and *removal* are step 3 (the
+vertices of L_r flatter than alpha_flat).
+
 ![fig7]({png})
 
 {md}
