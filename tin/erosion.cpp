@@ -43,16 +43,21 @@ VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* insert
 std::size_t TinTerrain::refine_around(VertexHandle v) {
   std::size_t splits = 0;
   for (int guard = 0; guard < 64 && has_long_edges(v); ++guard) {
+    // The longest edge that can be split: a constrained edge only where its middle is
+    // exactly on it (else the new vertex would sit beside the constraint, in a sliver).
     VertexHandle far;
     double longest = refine_m_;
     auto c = cdt_.incident_vertices(v), done = c;
     do {
       if (cdt_.is_infinite(c)) continue;
       const double d = (xy(c) - xy(v)).norm();
-      if (d > longest) {
-        longest = d;
-        far = c;
-      }
+      if (d <= longest) continue;
+      FaceHandle f;
+      int i = 0;
+      if (cdt_.is_edge(v, c, f, i) && f->is_constrained(i) && locate(0.5 * (xy(c) + xy(v))).type != Cdt::EDGE)
+        continue;
+      longest = d;
+      far = c;
     } while (++c != done);
     if (far == VertexHandle()) break;
     bool inserted = false;

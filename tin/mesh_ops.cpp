@@ -301,7 +301,9 @@ bool circumcircle_meets(FaceHandle f, const Aabb2& box, double margin) {
   const double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy;
   const double ux = (cy * b2 - by * c2) / d, uy = (bx * c2 - cx * b2) / d;
   const double r = std::sqrt(ux * ux + uy * uy);
-  if (!std::isfinite(r)) return true;
+  // A sliver's circle is computed with a large relative error: include it (it is rare).
+  const double longest = std::sqrt(std::max({b2, c2, (bx - cx) * (bx - cx) + (by - cy) * (by - cy)}));
+  if (!std::isfinite(r) || r > 1e3 * longest) return true;
   const double ox = a.x() + ux, oy = a.y() + uy;
   const double dx = std::max({box.lo.x() - ox, 0.0, ox - box.hi.x()});
   const double dy = std::max({box.lo.y() - oy, 0.0, oy - box.hi.y()});

@@ -300,7 +300,10 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   for (VertexHandle v : i_verts) own.push_back(&*v);
   std::sort(own.begin(), own.end());
   auto is_own = [&own](VertexHandle v) { return std::binary_search(own.begin(), own.end(), &*v); };
-  auto in_footprint = [&](const Vec2& p) { return s.contains(p) || distance_to_boundary(footprint, p) <= tiny; };
+  const Aabb2 footprint_bounds = bounds(footprint).expanded(2.0 * tiny);
+  auto in_footprint = [&](const Vec2& p) {
+    return footprint_bounds.contains(p) && (s.contains(p) || distance_to_boundary(footprint, p) <= tiny);
+  };
 
   // Old vertices between I and O would bend the wall, and those just outside O would crowd
   // it: removed.
