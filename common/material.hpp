@@ -11,8 +11,8 @@ inline double rad_to_deg(double rad) { return rad * 180.0 / std::numbers::pi; }
 struct Material {
   double critical_angle_deg = 30.0;  // angle of repose; dry sand 30-35, damp higher
   // Fraction of a pair's excess moved per erosion visit. (0, 1] settles monotonically;
-  // (1, 2) overshoots but still lowers the potential energy; above 2 a transfer can raise it
-  // and erosion may oscillate (allowed up to 4 for stability studies).
+  // (1, 2] overshoots but a pair's transfer still lowers the potential energy; above 2 it
+  // can raise it, erosion oscillates and heights diverge, so scenes refuse it.
   double transfer_fraction = 0.5;
   // Haptic parameters (used by the force model): penetration stiffness, velocity drag,
   // Coulomb friction coefficient against the penetration force.

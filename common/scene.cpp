@@ -261,7 +261,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
 
   // [material]
   s.material.critical_angle_deg = f.number("material.critical_angle_deg", 30.0, open(0.0, 90.0));
-  s.material.transfer_fraction = f.number("material.transfer_fraction", 0.5, {0.0, 4.0, true, false});
+  s.material.transfer_fraction = f.number("material.transfer_fraction", 0.5, {0.0, 2.0, true, false});
   s.material.stiffness_n_per_m = f.number("material.stiffness_n_per_m", 800.0, closed(0.0, 1e6));
   s.material.drag_n_s_per_m = f.number("material.drag_n_s_per_m", 5.0, closed(0.0, 1e4));
   s.material.friction = f.number("material.friction", 0.4, closed(0.0, 10.0));

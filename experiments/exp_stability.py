@@ -36,6 +36,8 @@ CASES = {
                     f"stroke.path_m=[[{1e6 + C - .035}, {1e6 + C - .035}], [{1e6 + C + .035}, {1e6 + C + .035}]]"], None),
     "angle_1": ("critical angle 1 degree", ["material.critical_angle_deg=1"], None),
     "angle_85": ("critical angle 85 degrees", ["material.critical_angle_deg=85"], None),
+    "overshooting_fraction": ("erosion fraction 1.9, overshooting (monotone only up to 1)",
+                              ["material.transfer_fraction=1.9", "output.energy=true"], None),
     "unstable_fraction": ("erosion fraction 3, above its stable limit of 2",
                           ["material.transfer_fraction=3", "output.energy=true"], None),
     "nan_value": ("NaN in the scene file", [], "radius_m = nan"),
@@ -68,10 +70,13 @@ def classify(name, backend, proc, summary, run_file):
     if proc.returncode != 0:
         return "crashed", f"exit {proc.returncode}: {proc.stderr.strip()[-160:]}"
     reasons = []
-    drift = abs(summary["volume_drift_rel"])
+    nan = [k for k in ("volume_drift_rel", "max_slope_excess_deg") if summary.get(k) is None]  # JSON null: NaN
+    if nan:
+        reasons.append(f"{', '.join(nan)} not a number")
+    drift = abs(summary["volume_drift_rel"] or 0.0)
     if drift > 1e-6:
         reasons.append(f"volume drift {drift:.1e}")
-    if summary["max_slope_excess_deg"] > 1.0:
+    if (summary["max_slope_excess_deg"] or 0.0) > 1.0:
         reasons.append(f"slope excess {summary['max_slope_excess_deg']:.1f} deg")
     if not summary.get("settled", True):
         reasons.append("not settled")

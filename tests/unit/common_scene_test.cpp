@@ -77,7 +77,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{{"tool.radius_m=-0.01"}, "tool.radius_m", "out of range"},
         BadField{{"tool.radius_m=0"}, "tool.radius_m", "(0,"},
         BadField{{"material.critical_angle_deg=90"}, "material.critical_angle_deg", "(0, 90)"},
-        BadField{{"material.transfer_fraction=4.5"}, "material.transfer_fraction", "out of range"},
+        BadField{{"material.transfer_fraction=2.5"}, "material.transfer_fraction", "out of range"},
         BadField{{"grid.cell_m=-1"}, "grid.cell_m", "out of range"},
         BadField{{"grid.neighbours=6"}, "grid.neighbours", "4 or 8"},
         BadField{{"stroke.spacing_m=0"}, "stroke.spacing_m", "out of range"},
