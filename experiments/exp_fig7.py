@@ -66,8 +66,9 @@ vertices of L_r flatter than alpha_flat).
   {slopes['removal']:.2f} for removal, {slopes['total']:.2f} for the TIN's total. Point location walks from the
   last located face, and the lists L_e and L_r hold only what the tool touched, so the cost of a stroke depends
   on the stroke, not on the size of the model.
-- The grid at the same number of nodes: exponent {grid_slope:.2f} for its total (its work is the tool's
-  footprint and the erosion's active set, also independent of the model size).
+- The grid at the same number of nodes: exponent {grid_slope:.2f} for its total. A grid of more nodes has
+  smaller cells, so the same tool covers more of them: its cost follows the nodes under the tool and in the
+  erosion's active set (about N^1 for a fixed tool), never the whole grid.
 """
     return text
 
