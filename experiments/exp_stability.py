@@ -86,7 +86,10 @@ def classify(name, backend, proc, summary, run_file):
 
 
 def run(ctx):
-    backends = ["tin", "grid"]
+    # Column label -> (back-end, extra overrides). The TIN's default does not conserve volume
+    # (as in the paper), so it also runs with tin.conserve_volume to show what else degrades.
+    columns = {"tin": ("tin", []), "tin conserve_volume": ("tin", ["tin.conserve_volume=true"]), "grid": ("grid", [])}
+    backends = list(columns)
     rows, outcomes = [], {}
     out_dir = ctx.runs / "stability"
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -94,14 +97,16 @@ def run(ctx):
         cases = {k: v for k, v in CASES.items() if k in ctx.profile.get("stability_cases", CASES)}
         for name, (desc, overrides, bad_text) in cases.items():
             for backend in backends:
-                result_path = out_dir / f"{name}-{backend}.result.json"
+                engine, extra = columns[backend]
+                safe = backend.replace(" ", "_")
+                result_path = out_dir / f"{name}-{safe}.result.json"
                 if result_path.exists():
                     res = json.loads(result_path.read_text())
                 else:
                     scene = scene_with(bad_text, tmp) if bad_text else BASE
-                    run_file = out_dir / f"{name}-{backend}.h5"
-                    cmd = [str(ctx.sandbench), "run", str(scene), "--backend", backend, "--out", str(run_file),
-                           "--json"] + [a for o in overrides for a in ("--set", o)]
+                    run_file = out_dir / f"{name}-{safe}.h5"
+                    cmd = [str(ctx.sandbench), "run", str(scene), "--backend", engine, "--out", str(run_file),
+                           "--json"] + [a for o in overrides + extra for a in ("--set", o)]
                     try:
                         proc = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT_S)
                         summary = json.loads(proc.stdout) if proc.returncode == 0 else {}

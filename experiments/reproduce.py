@@ -89,6 +89,9 @@ def main():
         sections.append(EXPERIMENTS[name].run(ctx))
         sbrun.progress(f"[{i}/{len(names)}] {name} done in {time.monotonic() - start:.0f} s")
 
+    if args.only:  # a partial run prints its sections; only a full run writes REPORT.md
+        print("\n".join(sections))
+        return
     report = ("# sandbench: reproducing Purchart's TIN sand model\n\n" + machine_header(ctx) + "\n" + INTRO + "\n" +
               "\n".join(sections))
     tmp = ctx.results / "REPORT.md.tmp"
