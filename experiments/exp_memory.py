@@ -78,16 +78,18 @@ def run(ctx):
     else:
         equal = (f"at the TIN's error ({e0:.2e} m) a grid needs about {gb / 1e3:.0f} kB against the TIN's "
                  f"{t0['memory_bytes'] / 1e3:.0f} kB ({gb / t0['memory_bytes']:.1f}x)")
-    smaller = all(t["memory_bytes"] < g["memory_bytes"] for t in tins for g in grid[-2:])
+    # The claim is judged at equal accuracy; without an equal-accuracy grid, against the finest grid.
+    smaller = gb > t0["memory_bytes"] if not math.isnan(gb) else t0["memory_bytes"] < grid[-1]["memory_bytes"]
     return f"""## Memory against resolution and at equal accuracy
 
 ![memory]({png})
 
 {md}
-- *Paper: a TIN needs significantly less memory than a grid.* Ours: {'reproduced' if smaller else 'not reproduced'}
+- *Paper: a TIN needs significantly less memory than a grid.* Ours: {'reproduced' if smaller else 'not reproduced at equal accuracy'}
   for a flat scene: the TIN holds {t0['vertices']} vertices ({t0['memory_bytes'] / 1e3:.0f} kB) after the stroke,
   the {cells[-1] * 1000:g} mm grid {grid[-1]['cells']} nodes ({grid[-1]['memory_bytes'] / 1e3:.0f} kB); {equal}.
-  The TIN's advantage is largest where the terrain is flat and shrinks as detail spreads over the domain.
+  A TIN vertex costs about 170 bytes against a grid node's 10, so the TIN wins only where it needs at least
+  17 times fewer elements than a grid of the same accuracy: on large flat areas, not around a single stroke.
 """
 
 
