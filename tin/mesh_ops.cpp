@@ -209,7 +209,16 @@ void TinTerrain::remove_vertex(VertexHandle v) {
 
 void TinTerrain::constrain(VertexHandle a, VertexHandle b, std::uint32_t generation) {
   if (a == b) return;
-  cdt_.insert_constraint(a, b);
+  try {
+    cdt_.insert_constraint(a, b);
+  } catch (const Cdt::Intersection_of_constraints_exception&) {
+    // An old constraint crosses a-b where the stamp could not drop it (found by the stamp
+    // fuzzer: a footprint grazing the domain border). CGAL throws while searching, before it
+    // changes the triangulation, so a-b stays unconstrained; pieces of it inserted before the
+    // crossing are recorded here. Rare, so the O(n) scan is acceptable.
+    record_unrecorded_constraints(generation);
+    return;
+  }
   // The constraint is split where it passes through vertices: record every piece.
   const auto orient = cdt_.geom_traits().orientation_2_object();
   VertexHandle cur = a, prev;
@@ -236,6 +245,14 @@ void TinTerrain::constrain(VertexHandle a, VertexHandle b, std::uint32_t generat
     generations_[EdgeKey(cur, next)] = generation;
     prev = cur;
     cur = next;
+  }
+}
+
+void TinTerrain::record_unrecorded_constraints(std::uint32_t generation) {
+  for (auto e = cdt_.finite_edges_begin(); e != cdt_.finite_edges_end(); ++e) {
+    if (!e->first->is_constrained(e->second)) continue;
+    const EdgeKey key(e->first->vertex(Cdt::ccw(e->second)), e->first->vertex(Cdt::cw(e->second)));
+    generations_.try_emplace(key, generation);
   }
 }
 

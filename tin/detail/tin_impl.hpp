@@ -143,6 +143,8 @@ class TinTerrain final : public Terrain {
   void remove_vertex(VertexHandle v);
   void constrain(VertexHandle a, VertexHandle b, std::uint32_t generation);
   void unconstrain(VertexHandle a, VertexHandle b);
+  // Gives every constrained edge without a generation record this generation. O(n).
+  void record_unrecorded_constraints(std::uint32_t generation);
   bool has_constraints(VertexHandle v) const;
   double vertex_area(VertexHandle v) const;
   void set_z(VertexHandle v, double z);
