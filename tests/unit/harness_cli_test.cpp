@@ -1,33 +1,18 @@
 // The sandbench command line, run as a process: exit codes, messages, whole-or-nothing output.
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <sys/wait.h>
+
+#include "harness_test_support.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int code = -1;
-  std::string out;  // stdout and stderr together
-};
-
-Result sandbench(const std::string& args) {
-  const std::string cmd = std::string(SB_CLI_PATH) + " " + args + " 2>&1";
-  Result r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
-  const int status = ::pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using sb::test::sandbench;  // the binary as a process (harness_test_support.hpp)
 
 std::string scene(const char* name) { return std::string(SB_SOURCE_DIR) + "/experiments/scenes/" + name; }
 
@@ -45,7 +30,7 @@ class Cli : public ::testing::Test {
 
 TEST_F(Cli, BadSceneValueExitsTwoNamesTheFieldAndWritesNothing) {
   const fs::path out = dir_ / "run.h5";
-  const Result r = sandbench("run " + scene("flat_stroke.toml") + " --backend grid --out " + out.string() +
+  const auto r = sandbench("run " + scene("flat_stroke.toml") + " --backend grid --out " + out.string() +
                              " --set tool.radius_m=-3");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("tool.radius_m"), std::string::npos) << r.out;
@@ -56,7 +41,7 @@ TEST_F(Cli, BadSceneValueExitsTwoNamesTheFieldAndWritesNothing) {
 TEST_F(Cli, UnknownKeyInSceneFileExitsTwo) {
   const fs::path bad = dir_ / "bad.toml";
   std::ofstream(bad) << "[domain]\nsize_m = [1.0, 1.0]\nsizee = 2\n[stroke]\npath_m = [[0.5, 0.5]]\n";
-  const Result r = sandbench("run " + bad.string() + " --backend grid --out " + (dir_ / "x.h5").string());
+  const auto r = sandbench("run " + bad.string() + " --backend grid --out " + (dir_ / "x.h5").string());
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("domain.sizee"), std::string::npos) << r.out;
   EXPECT_FALSE(fs::exists(dir_ / "x.h5"));
@@ -73,7 +58,7 @@ TEST_F(Cli, MissingSceneFileAndBadOptionsExitTwo) {
 
 TEST_F(Cli, RunPrintsEveryContractMetricAndWritesTheRunFile) {
   const fs::path out = dir_ / "grid.h5";
-  const Result r = sandbench("run " + scene("flat_stroke.toml") + " --backend grid --json --out " + out.string());
+  const auto r = sandbench("run " + scene("flat_stroke.toml") + " --backend grid --json --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.out;
   const auto json_start = r.out.find('{');
   const auto json = nlohmann::json::parse(r.out.substr(json_start, r.out.rfind('}') - json_start + 1));

@@ -2,6 +2,8 @@
 // PNG16 heightmap reloads as a scene heightmap within one quantisation step; `sandbench
 // export` refuses bad input with exit code 2 and leaves nothing behind.
 #include <gtest/gtest.h>
+
+#include "harness_test_support.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -236,26 +238,11 @@ TEST(ExportFormat, OnlyThreeFormatsAreAccepted) {
   EXPECT_THROW(parse_export_format("stl"), InputError);
 }
 
-// `sandbench export` as a process.
-struct Result {
-  int code = -1;
-  std::string out;
-};
-
-Result sandbench(const std::string& args) {
-  const std::string cmd = std::string(SB_CLI_PATH) + " " + args + " 2>&1";
-  Result r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
-  const int status = ::pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using test::sandbench;  // the binary as a process (harness_test_support.hpp)
 
 TEST_F(Export, CommandWritesEachFormatAndRefusesBadInput) {
   const fs::path run = dir_ / "grid.h5";
-  Result r = sandbench("run " + std::string(SB_SOURCE_DIR) + "/experiments/scenes/flat_stroke.toml --backend grid --out " +
+  auto r = sandbench("run " + std::string(SB_SOURCE_DIR) + "/experiments/scenes/flat_stroke.toml --backend grid --out " +
                        run.string());
   ASSERT_EQ(r.code, 0) << r.out;
   for (const char* format : {"ply", "obj", "png16"}) {

@@ -2,6 +2,8 @@
 // a window, and a recorded session replayed by `sandbench run --replay` on both back-ends.
 #include <gtest/gtest.h>
 
+#include "harness_test_support.hpp"
+
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -24,21 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int code = -1;
-  std::string out;
-};
-
-Result sandbench(const std::string& args) {
-  const std::string cmd = std::string(SB_CLI_PATH) + " " + args + " 2>&1";
-  Result r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
-  const int status = ::pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using test::sandbench;  // the binary as a process (harness_test_support.hpp)
 
 nlohmann::json last_json(const std::string& out) {
   const auto a = out.find('{'), b = out.rfind('}');
@@ -242,7 +230,7 @@ TEST_F(Session_, RunReplaysASessionOnBothBackEnds) {
   s.overrides.clear();
   write_session(file, s);
   for (const std::string backend : {"grid", "tin"}) {
-    const Result r = sandbench("run " + scene_path() + " --backend " + backend + " --replay " + file.string() +
+    const auto r = sandbench("run " + scene_path() + " --backend " + backend + " --replay " + file.string() +
                                " --json --out " + (dir_ / (backend + ".h5")).string());
     ASSERT_EQ(r.code, 0) << r.out;
     const auto j = last_json(r.out);
@@ -255,7 +243,7 @@ TEST_F(Session_, RunReplaysASessionOnBothBackEnds) {
 
 TEST_F(Session_, BadReplayAndInteractiveOptionsExitTwoBeforeAnyWindow) {
   const std::string scene = scene_path();
-  Result r = sandbench("run " + scene + " --backend grid --replay " + (dir_ / "none.csv").string());
+  auto r = sandbench("run " + scene + " --backend grid --replay " + (dir_ / "none.csv").string());
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("--replay"), std::string::npos) << r.out;
   const fs::path traj = dir_ / "traj.csv";

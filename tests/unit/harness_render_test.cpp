@@ -2,6 +2,8 @@
 // `sandbench render` as a process: pictures are not blank, shading agrees with the
 // heights, output is deterministic, bad input exits 2 and leaves nothing behind.
 #include <gtest/gtest.h>
+
+#include "harness_test_support.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -283,22 +285,7 @@ TEST(ComparePictures, DifferenceMapIsRedWhereTheSecondIsHigher) {
   EXPECT_THROW(difference_map({runs.front()}, frame), std::invalid_argument);
 }
 
-// `sandbench render` as a process.
-struct Result {
-  int code = -1;
-  std::string out;
-};
-
-Result sandbench(const std::string& args) {
-  const std::string cmd = std::string(SB_CLI_PATH) + " " + args + " 2>&1";
-  Result r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
-  const int status = ::pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+using test::sandbench;  // the binary as a process (harness_test_support.hpp)
 
 // Width and height from a PNG's IHDR chunk; (0, 0) when the file is not a PNG.
 std::pair<int, int> png_size(const fs::path& file) {
@@ -317,7 +304,7 @@ class RenderCli : public ::testing::Test {
                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
     run_ = dir_ / "grid.h5";
-    const Result r = sandbench("run " + std::string(SB_SOURCE_DIR) + "/experiments/scenes/flat_stroke.toml --backend grid --out " +
+    const auto r = sandbench("run " + std::string(SB_SOURCE_DIR) + "/experiments/scenes/flat_stroke.toml --backend grid --out " +
                                run_.string());
     ASSERT_EQ(r.code, 0) << r.out;
   }
@@ -327,7 +314,7 @@ class RenderCli : public ::testing::Test {
 };
 
 TEST_F(RenderCli, WritesPicturesOfTheRequestedSize) {
-  Result r = sandbench("render " + run_.string() + " -o " + (dir_ / "a.png").string());
+  auto r = sandbench("render " + run_.string() + " -o " + (dir_ / "a.png").string());
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_EQ(png_size(dir_ / "a.png"), std::make_pair(1024, 768));
   r = sandbench("render " + run_.string() + " -o " + (dir_ / "b.png").string() +
@@ -339,11 +326,11 @@ TEST_F(RenderCli, WritesPicturesOfTheRequestedSize) {
 TEST_F(RenderCli, BadInputExitsTwoNamesTheOptionAndWritesNothing) {
   const std::string out = (dir_ / "x.png").string();
   for (const char* size : {"100", "10x10", "100x", "axb", "100x100000", "-5x20"}) {
-    const Result r = sandbench("render " + run_.string() + " -o " + out + " --size " + size);
+    const auto r = sandbench("render " + run_.string() + " -o " + out + " --size " + size);
     EXPECT_EQ(r.code, 2) << size << ": " << r.out;
     EXPECT_NE(r.out.find("--size"), std::string::npos) << r.out;
   }
-  Result r = sandbench("render " + run_.string() + " -o " + out + " --view side");
+  auto r = sandbench("render " + run_.string() + " -o " + out + " --view side");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("--view"), std::string::npos) << r.out;
   r = sandbench("render " + (dir_ / "missing.h5").string() + " -o " + out);
