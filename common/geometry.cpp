@@ -59,15 +59,15 @@ int orientation(const Vec2& a, const Vec2& b, const Vec2& c) {
   return (v > 0.0) - (v < 0.0);
 }
 bool on_segment(const Vec2& a, const Vec2& b, const Vec2& p) {
-  return std::min(a.x(), b.x()) <= p.x() && p.x() <= std::max(a.x(), b.x()) &&
-         std::min(a.y(), b.y()) <= p.y() && p.y() <= std::max(a.y(), b.y());
+  return std::min(a.x(), b.x()) <= p.x() && p.x() <= std::max(a.x(), b.x()) && std::min(a.y(), b.y()) <= p.y() &&
+         p.y() <= std::max(a.y(), b.y());
 }
 bool segments_intersect(const Vec2& a, const Vec2& b, const Vec2& c, const Vec2& d) {
   const int o1 = orientation(a, b, c), o2 = orientation(a, b, d);
   const int o3 = orientation(c, d, a), o4 = orientation(c, d, b);
   if (o1 != o2 && o3 != o4) return true;
-  return (o1 == 0 && on_segment(a, b, c)) || (o2 == 0 && on_segment(a, b, d)) ||
-         (o3 == 0 && on_segment(c, d, a)) || (o4 == 0 && on_segment(c, d, b));
+  return (o1 == 0 && on_segment(a, b, c)) || (o2 == 0 && on_segment(a, b, d)) || (o3 == 0 && on_segment(c, d, a)) ||
+         (o4 == 0 && on_segment(c, d, b));
 }
 }  // namespace
 
@@ -78,8 +78,7 @@ bool is_simple_polygon(std::span<const Vec2> polygon) {
     for (std::size_t j = i + 1; j < n; ++j) {
       const bool adjacent = j == i + 1 || (i == 0 && j == n - 1);
       if (adjacent) continue;
-      if (segments_intersect(polygon[i], polygon[(i + 1) % n], polygon[j], polygon[(j + 1) % n]))
-        return false;
+      if (segments_intersect(polygon[i], polygon[(i + 1) % n], polygon[j], polygon[(j + 1) % n])) return false;
     }
   }
   return std::abs(signed_area(polygon)) > 0.0;

@@ -16,9 +16,7 @@ struct Aabb2 {
   bool contains(const Vec2& p) const {
     return p.x() >= lo.x() && p.x() <= hi.x() && p.y() >= lo.y() && p.y() <= hi.y();
   }
-  Aabb2 expanded(double margin) const {
-    return {lo - Vec2(margin, margin), hi + Vec2(margin, margin)};
-  }
+  Aabb2 expanded(double margin) const { return {lo - Vec2(margin, margin), hi + Vec2(margin, margin)}; }
 };
 
 // 2-D cross product (z of the 3-D cross product).

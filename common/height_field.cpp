@@ -61,7 +61,8 @@ HeightField HeightField::from_scene(const Scene& scene) {
 
 double HeightField::operator()(const Vec2& p) const {
   switch (kind_) {
-    case TerrainKind::Flat: return base_m_;
+    case TerrainKind::Flat:
+      return base_m_;
     case TerrainKind::Dunes: {
       double sum = 0.0;
       for (const Ridge& r : ridges_) {

@@ -22,7 +22,7 @@ class HeightField {
 
  private:
   struct Ridge {
-    Vec2 wave;   // direction * 2 pi / wavelength
+    Vec2 wave;  // direction * 2 pi / wavelength
     double phase;
     double weight;
   };

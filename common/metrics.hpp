@@ -11,9 +11,7 @@ namespace sb {
 class Stopwatch {
  public:
   Stopwatch() : start_(std::chrono::steady_clock::now()) {}
-  double seconds() const {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  }
+  double seconds() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
   void restart() { start_ = std::chrono::steady_clock::now(); }
 
  private:
@@ -26,9 +24,9 @@ struct StepRecord {
   std::int64_t stamp = -1;
   double time_tool_s = 0.0, time_erosion_s = 0.0, time_simplify_s = 0.0;
   double time_detect_s = 0.0, time_remove_s = 0.0;  // the two parts of simplify
-  double volume_m3 = 0.0;                            // after the step
+  double volume_m3 = 0.0;                           // after the step
   double volume_delta_tool = 0.0, volume_delta_erosion = 0.0, volume_delta_simplify = 0.0;
-  double volume_added = 0.0;                         // poured in this step
+  double volume_added = 0.0;  // poured in this step
   std::uint64_t vertices = 0, triangles = 0, constrained_edges = 0, cells = 0, bytes = 0;
   std::uint64_t active = 0, erosion_updates = 0, erosion_transfers = 0;
   std::uint64_t elements_touched = 0, removed = 0, walk_steps = 0;

@@ -17,25 +17,22 @@ struct FileCloser {
 };
 using File = std::unique_ptr<std::FILE, FileCloser>;
 
-[[noreturn]] void png_error_handler(png_structp, png_const_charp message) {
-  throw std::runtime_error(message);
-}
+[[noreturn]] void png_error_handler(png_structp, png_const_charp message) { throw std::runtime_error(message); }
 void png_warning_handler(png_structp, png_const_charp) {}
 
 // Writes one PNG with the given colour type and 8 or 16 bits per sample; rows big-endian.
-void write_png(const std::filesystem::path& file, std::size_t width, std::size_t height, int color_type,
-               int bit_depth, const std::vector<std::vector<png_byte>>& rows,
+void write_png(const std::filesystem::path& file, std::size_t width, std::size_t height, int color_type, int bit_depth,
+               const std::vector<std::vector<png_byte>>& rows,
                const std::vector<std::pair<std::string, std::string>>& text) {
   write_atomically(file, [&](const std::filesystem::path& tmp) {
     File f(std::fopen(tmp.c_str(), "wb"));
     if (!f) throw std::runtime_error("cannot write " + tmp.string());
-    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, png_error_handler,
-                                              png_warning_handler);
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, png_error_handler, png_warning_handler);
     png_infop info = png_create_info_struct(png);
     try {
       png_init_io(png, f.get());
-      png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), bit_depth,
-                   color_type, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+      png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), bit_depth, color_type,
+                   PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
       std::vector<png_text> chunks(text.size());
       for (std::size_t i = 0; i < text.size(); ++i) {
         chunks[i].compression = PNG_TEXT_COMPRESSION_NONE;
@@ -62,8 +59,7 @@ Png16 read_png16(const std::filesystem::path& file, const std::string& field) {
   png_byte sig[8];
   if (std::fread(sig, 1, 8, f.get()) != 8 || png_sig_cmp(sig, 0, 8) != 0)
     throw InputError("scene: " + field + " = \"" + file.string() + "\" is not a PNG file");
-  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, png_error_handler,
-                                           png_warning_handler);
+  png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, png_error_handler, png_warning_handler);
   png_infop info = png_create_info_struct(png);
   Png16 out;
   try {
@@ -73,9 +69,8 @@ Png16 read_png16(const std::filesystem::path& file, const std::string& field) {
     const int depth = png_get_bit_depth(png, info);
     const int type = png_get_color_type(png, info);
     if (depth != 16 || (type != PNG_COLOR_TYPE_GRAY && type != PNG_COLOR_TYPE_GRAY_ALPHA))
-      throw InputError("scene: " + field + " = \"" + file.string() +
-                       "\" must be a 16-bit greyscale PNG (got " + std::to_string(depth) + "-bit, colour type " +
-                       std::to_string(type) + ")");
+      throw InputError("scene: " + field + " = \"" + file.string() + "\" must be a 16-bit greyscale PNG (got " +
+                       std::to_string(depth) + "-bit, colour type " + std::to_string(type) + ")");
     out.width = png_get_image_width(png, info);
     out.height = png_get_image_height(png, info);
     if (out.width < 2 || out.height < 2)

@@ -26,8 +26,8 @@ double Raster::interpolate(const Vec2& p) const {
   const auto iy = std::min(static_cast<std::size_t>(gy), ny > 1 ? ny - 2 : 0);
   const double tx = nx > 1 ? gx - ix : 0.0, ty = ny > 1 ? gy - iy : 0.0;
   const std::size_t ix1 = std::min(ix + 1, nx - 1), iy1 = std::min(iy + 1, ny - 1);
-  return (1 - tx) * (1 - ty) * at(ix, iy) + tx * (1 - ty) * at(ix1, iy) +
-         (1 - tx) * ty * at(ix, iy1) + tx * ty * at(ix1, iy1);
+  return (1 - tx) * (1 - ty) * at(ix, iy) + tx * (1 - ty) * at(ix1, iy) + (1 - tx) * ty * at(ix, iy1) +
+         tx * ty * at(ix1, iy1);
 }
 
 RasterDifference compare_rasters(const Raster& a, const Raster& b) {

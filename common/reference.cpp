@@ -9,9 +9,7 @@ namespace sb {
 
 namespace {
 
-double cone_radius(double volume, double tan_angle) {
-  return std::cbrt(3.0 * volume / (std::numbers::pi * tan_angle));
-}
+double cone_radius(double volume, double tan_angle) { return std::cbrt(3.0 * volume / (std::numbers::pi * tan_angle)); }
 
 // Least-squares slope of y against x; 0 with fewer than two distinct x.
 double fitted_slope(const std::vector<double>& x, const std::vector<double>& y) {
@@ -53,8 +51,10 @@ Raster crater_reference(const ToolStamp& s, const HeightField& initial, const Ra
   for (int iy = 0; iy < n; ++iy)
     for (int ix = 0; ix < n; ++ix) {
       const Vec2 p = box.lo + Vec2((ix + 0.5) * d.x(), (iy + 0.5) * d.y());
-      if (s.contains(p)) cut += std::max(0.0, initial(p) - s.bottom_z(p));
-      else rim += s.rim_weight(p);
+      if (s.contains(p))
+        cut += std::max(0.0, initial(p) - s.bottom_z(p));
+      else
+        rim += s.rim_weight(p);
     }
   const double scale = rim > 0.0 ? cut / rim : 0.0;  // both in units of the quadrature cell
   Raster r = lattice;
@@ -69,8 +69,8 @@ Raster crater_reference(const ToolStamp& s, const HeightField& initial, const Ra
 
 }  // namespace
 
-std::optional<Raster> reference_raster(const Scene& scene, const StampSchedule& schedule,
-                                       const HeightField& initial, const Raster& lattice) {
+std::optional<Raster> reference_raster(const Scene& scene, const StampSchedule& schedule, const HeightField& initial,
+                                       const Raster& lattice) {
   if (schedule.stamps.empty()) return std::nullopt;
   const ToolStamp& first = schedule.stamps.front();
   switch (scene.reference) {
@@ -87,9 +87,11 @@ std::optional<Raster> reference_raster(const Scene& scene, const StampSchedule& 
         }
       return r;
     }
-    case ReferenceKind::Crater: return crater_reference(first, initial, lattice);
+    case ReferenceKind::Crater:
+      return crater_reference(first, initial, lattice);
     case ReferenceKind::Trench:
-    case ReferenceKind::None: return std::nullopt;
+    case ReferenceKind::None:
+      return std::nullopt;
   }
   return std::nullopt;
 }
@@ -166,9 +168,8 @@ TrenchShape measure_trench(const Raster& h, const Raster& initial, const Vec2& a
   return shape;
 }
 
-nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule& schedule,
-                                        const HeightField& initial, const Raster& initial_raster,
-                                        const Raster& final_raster) {
+nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule& schedule, const HeightField& initial,
+                                        const Raster& initial_raster, const Raster& final_raster) {
   nlohmann::ordered_json j = nlohmann::ordered_json::object();
   if (scene.reference == ReferenceKind::None || schedule.stamps.empty()) return j;
   j["reference"] = to_string(scene.reference);

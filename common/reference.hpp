@@ -20,8 +20,8 @@ namespace sb {
 
 // Heights of the reference shape on the raster's lattice; nullopt for trench (no shape,
 // only its metrics) and for scenes without a reference.
-std::optional<Raster> reference_raster(const Scene& scene, const StampSchedule& schedule,
-                                       const HeightField& initial, const Raster& lattice);
+std::optional<Raster> reference_raster(const Scene& scene, const StampSchedule& schedule, const HeightField& initial,
+                                       const Raster& lattice);
 
 struct PileShape {
   double flank_angle_deg = 0.0;  // fitted slope of height against radius on the flank
@@ -40,8 +40,7 @@ TrenchShape measure_trench(const Raster& heights, const Raster& initial, const V
 
 // The accuracy metrics of DESIGN.md for the scene's reference, as summary entries
 // ("reference.rmse_m", "pile.flank_angle_deg", ...). Empty when the scene has none.
-nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule& schedule,
-                                        const HeightField& initial, const Raster& initial_raster,
-                                        const Raster& final_raster);
+nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule& schedule, const HeightField& initial,
+                                        const Raster& initial_raster, const Raster& final_raster);
 
 }  // namespace sb

@@ -1,11 +1,12 @@
 #include "common/scene.hpp"
 
+#include <toml++/toml.h>
+
 #include <cmath>
 #include <fstream>
 #include <limits>
 #include <set>
 #include <sstream>
-#include <toml++/toml.h>
 
 #include "common/input_error.hpp"
 
@@ -13,19 +14,26 @@ namespace sb {
 
 std::string to_string(TerrainKind k) {
   switch (k) {
-    case TerrainKind::Flat: return "flat";
-    case TerrainKind::Dunes: return "dunes";
-    case TerrainKind::Heightmap: return "heightmap";
+    case TerrainKind::Flat:
+      return "flat";
+    case TerrainKind::Dunes:
+      return "dunes";
+    case TerrainKind::Heightmap:
+      return "heightmap";
   }
   return "?";
 }
 
 std::string to_string(ReferenceKind k) {
   switch (k) {
-    case ReferenceKind::None: return "none";
-    case ReferenceKind::Pile: return "pile";
-    case ReferenceKind::Crater: return "crater";
-    case ReferenceKind::Trench: return "trench";
+    case ReferenceKind::None:
+      return "none";
+    case ReferenceKind::Pile:
+      return "pile";
+    case ReferenceKind::Crater:
+      return "crater";
+    case ReferenceKind::Trench:
+      return "trench";
   }
   return "?";
 }
@@ -38,9 +46,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 struct Range {
   double lo = -kInf, hi = kInf;
   bool lo_open = false, hi_open = false;
-  bool contains(double v) const {
-    return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
-  }
+  bool contains(double v) const { return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi); }
   std::string str() const {
     auto num = [](double v) {
       if (std::isinf(v)) return std::string(v > 0 ? "inf" : "-inf");
@@ -108,8 +114,7 @@ class Fields {
     return *n->value<bool>();
   }
 
-  std::string choice(const std::string& key, const std::string& fallback,
-                     const std::vector<std::string>& allowed) {
+  std::string choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& allowed) {
     const toml::node* n = find(key);
     std::string list;
     for (const auto& a : allowed) list += (list.empty() ? "" : " | ") + a;
@@ -134,10 +139,11 @@ class Fields {
   }
 
   // An array of numbers; `count` 0 means any length >= min_count.
-  std::vector<double> numbers(const std::string& key, std::size_t count, std::size_t min_count,
-                              Range range, bool required, std::vector<double> fallback = {}) {
+  std::vector<double> numbers(const std::string& key, std::size_t count, std::size_t min_count, Range range,
+                              bool required, std::vector<double> fallback = {}) {
     const toml::node* n = find(key);
-    const std::string shape = count ? std::to_string(count) + " numbers" : "at least " + std::to_string(min_count) + " numbers";
+    const std::string shape =
+        count ? std::to_string(count) + " numbers" : "at least " + std::to_string(min_count) + " numbers";
     if (!n) {
       if (required) fail(key, "is missing; it must be an array of " + shape + " in " + range.str());
       return fallback;
@@ -276,11 +282,13 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   // [tool]
   const std::string shape = f.choice("tool.shape", "disk", {"disk", "box", "ellipse", "polygon", "pour"});
   ToolSpec& t = s.tool;
-  t.shape = shape == "disk" ? ToolShape::Disk : shape == "box" ? ToolShape::Box
-          : shape == "ellipse" ? ToolShape::Ellipse : shape == "polygon" ? ToolShape::Polygon : ToolShape::Pour;
+  t.shape = shape == "disk"      ? ToolShape::Disk
+            : shape == "box"     ? ToolShape::Box
+            : shape == "ellipse" ? ToolShape::Ellipse
+            : shape == "polygon" ? ToolShape::Polygon
+                                 : ToolShape::Pour;
   const Range tool_size = positive(extent * 10.0);
-  if (t.shape == ToolShape::Disk || t.shape == ToolShape::Pour)
-    t.radius_m = f.number("tool.radius_m", 0.02, tool_size);
+  if (t.shape == ToolShape::Disk || t.shape == ToolShape::Pour) t.radius_m = f.number("tool.radius_m", 0.02, tool_size);
   if (t.shape == ToolShape::Box || t.shape == ToolShape::Ellipse) {
     const Vec2 size = f.vec2("tool.size_m", {0.04, 0.02}, tool_size, /*required=*/true);
     t.half_size_m = size / 2.0;
@@ -298,9 +306,9 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
     t.depth_m = f.number("tool.depth_m", 0.01, open(-1e6, 1e6));
     const std::string profile = f.choice("tool.profile", "flat", {"flat", "sphere_cap"});
     t.profile = profile == "flat" ? BottomProfile::Flat : BottomProfile::SphereCap;
-    if (t.profile == BottomProfile::SphereCap)
-      t.sphere_radius_m = f.number("tool.sphere_radius_m", 0.05, tool_size);
-    t.rim.width_m = f.number("tool.rim_width_m", 0.5 * (t.shape == ToolShape::Disk ? t.radius_m : t.half_size_m.minCoeff()), tool_size);
+    if (t.profile == BottomProfile::SphereCap) t.sphere_radius_m = f.number("tool.sphere_radius_m", 0.05, tool_size);
+    t.rim.width_m = f.number("tool.rim_width_m",
+                             0.5 * (t.shape == ToolShape::Disk ? t.radius_m : t.half_size_m.minCoeff()), tool_size);
     t.rim.forward_bias = f.number("tool.rim_forward_bias", 0.8, closed(0.0, 1.0));
   }
 
@@ -309,7 +317,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   s.stroke.z_m = f.numbers("stroke.z_m", 0, 1, open(-1e9, 1e9), false);
   if (!s.stroke.z_m.empty() && s.stroke.z_m.size() != s.stroke.path_m.size())
     Fields::fail("stroke.z_m", "has " + std::to_string(s.stroke.z_m.size()) + " values; it needs one per waypoint (" +
-                 std::to_string(s.stroke.path_m.size()) + ")");
+                                   std::to_string(s.stroke.path_m.size()) + ")");
   s.stroke.spacing_m = f.number("stroke.spacing_m", 0.005, positive(extent * 10.0));
   s.stroke.repeat = static_cast<int>(f.integer("stroke.repeat", 1, 1, 1000000));
   const double length = polyline_length(s.stroke.path_m);
@@ -331,15 +339,18 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   s.grid.cell_m = f.number("grid.cell_m", 0.005, positive(extent));
   const double cells = (s.domain.size_m.x() / s.grid.cell_m + 1) * (s.domain.size_m.y() / s.grid.cell_m + 1);
   if (cells > 2e9) Fields::fail("grid.cell_m", "gives more than 2e9 cells for this domain");
-  s.grid.storage = f.choice("grid.storage", "double", {"float", "double"}) == "float" ? GridStorage::Float : GridStorage::Double;
+  s.grid.storage =
+      f.choice("grid.storage", "double", {"float", "double"}) == "float" ? GridStorage::Float : GridStorage::Double;
   s.grid.neighbours = static_cast<int>(f.integer("grid.neighbours", 8, 4, 8));
   if (s.grid.neighbours != 4 && s.grid.neighbours != 8)
     Fields::fail("grid.neighbours", "= " + std::to_string(s.grid.neighbours) + " is not allowed; must be 4 or 8");
 
   // [reference]
   const std::string reference = f.choice("reference.kind", "none", {"none", "pile", "crater", "trench"});
-  s.reference = reference == "pile" ? ReferenceKind::Pile : reference == "crater" ? ReferenceKind::Crater
-              : reference == "trench" ? ReferenceKind::Trench : ReferenceKind::None;
+  s.reference = reference == "pile"     ? ReferenceKind::Pile
+                : reference == "crater" ? ReferenceKind::Crater
+                : reference == "trench" ? ReferenceKind::Trench
+                                        : ReferenceKind::None;
   if (s.reference == ReferenceKind::Pile && t.shape != ToolShape::Pour)
     Fields::fail("reference.kind", "= \"pile\" needs tool.shape = \"pour\"");
   if (s.reference == ReferenceKind::Trench && s.stroke.path_m.size() != 2)
@@ -354,8 +365,8 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
 
 }  // namespace
 
-Scene parse_scene(const std::string& text, const std::string& name,
-                  const std::vector<std::string>& overrides, const std::filesystem::path& base_dir) {
+Scene parse_scene(const std::string& text, const std::string& name, const std::vector<std::string>& overrides,
+                  const std::filesystem::path& base_dir) {
   toml::table root;
   try {
     root = toml::parse(text, name);

@@ -24,7 +24,7 @@ struct DomainSpec {
 
 struct TerrainSpec {
   TerrainKind kind = TerrainKind::Flat;
-  double height_m = 0.1;          // flat height; base height for dunes and heightmaps
+  double height_m = 0.1;  // flat height; base height for dunes and heightmaps
   // dunes: a seeded sum of sinusoidal ridges
   double dune_amplitude_m = 0.02;
   double dune_wavelength_m = 0.2;
@@ -44,25 +44,25 @@ struct ErosionSpec {
 };
 
 struct TinSpec {
-  double alpha_flat_deg = 0.4;        // the paper's alpha_flat, read as degrees
-  double tolerance_m = 0.001;         // greedy insertion: max height error of the initial TIN
-  bool conserve_volume = false;       // compensate simplification and flip volume changes
-  double contour_subdivision_m = 0.0; // outer contour subdivision step; 0: tool polygon only
-  double snap_m = 1e-6;               // points closer than this to a vertex reuse it
+  double alpha_flat_deg = 0.4;         // the paper's alpha_flat, read as degrees
+  double tolerance_m = 0.001;          // greedy insertion: max height error of the initial TIN
+  bool conserve_volume = false;        // compensate simplification and flip volume changes
+  double contour_subdivision_m = 0.0;  // outer contour subdivision step; 0: tool polygon only
+  double snap_m = 1e-6;                // points closer than this to a vertex reuse it
   // A TIN of about this many vertices from the start (a jittered lattice with heights from
   // the terrain), as in the paper's experiments; 0: as few as the terrain needs.
   long long initial_points = 0;
-  double initial_jitter = 0.5;        // lattice jitter, fraction of a cell; 0: exact lattice
-  double contour_gap_m = 0.0;         // outer-to-inner contour distance; 0: 5% of the tool size
-  double refine_m = 0.0;              // erosion splits edges longer than this that sand flows
-                                      // across; 0: half the tool (or pour) radius
+  double initial_jitter = 0.5;  // lattice jitter, fraction of a cell; 0: exact lattice
+  double contour_gap_m = 0.0;   // outer-to-inner contour distance; 0: 5% of the tool size
+  double refine_m = 0.0;        // erosion splits edges longer than this that sand flows
+                                // across; 0: half the tool (or pour) radius
 };
 
 enum class GridStorage { Float, Double };
 struct GridSpec {
   double cell_m = 0.005;
   GridStorage storage = GridStorage::Double;
-  int neighbours = 8;                 // 4 or 8
+  int neighbours = 8;  // 4 or 8
 };
 
 // The analytic shape the run is measured against (common/reference.hpp).
@@ -70,17 +70,17 @@ enum class ReferenceKind { None, Pile, Crater, Trench };
 std::string to_string(ReferenceKind k);
 
 struct OutputSpec {
-  double raster_m = 0.0025;           // spacing of the common comparison raster
+  double raster_m = 0.0025;  // spacing of the common comparison raster
   // Record the sand's potential energy after every step (costs one raster sample per step);
   // used to detect oscillating erosion, whose energy rises.
   bool energy = false;
 };
 
 struct Scene {
-  std::string path;                   // as given
-  std::string text;                   // the file's text, verbatim
-  std::vector<std::string> overrides; // "key=value" as given to --set
-  std::string resolved;               // the effective scene (TOML) after overrides
+  std::string path;                    // as given
+  std::string text;                    // the file's text, verbatim
+  std::vector<std::string> overrides;  // "key=value" as given to --set
+  std::string resolved;                // the effective scene (TOML) after overrides
 
   DomainSpec domain;
   TerrainSpec terrain;
@@ -97,8 +97,7 @@ struct Scene {
 // Loads and validates a scene; throws InputError naming the offending key.
 Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
 // Same, from text (base_dir resolves relative heightmap paths).
-Scene parse_scene(const std::string& text, const std::string& name,
-                  const std::vector<std::string>& overrides = {},
+Scene parse_scene(const std::string& text, const std::string& name, const std::vector<std::string>& overrides = {},
                   const std::filesystem::path& base_dir = {});
 
 }  // namespace sb

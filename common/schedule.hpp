@@ -9,15 +9,15 @@
 namespace sb {
 
 struct Stroke {
-  std::vector<Vec2> path_m;       // waypoints, at least one
-  std::vector<double> z_m;        // tool bottom z per waypoint; empty: surface - depth
-  double spacing_m = 0.005;       // arc length between stamps
-  int repeat = 1;                 // trace the whole stroke this many times
+  std::vector<Vec2> path_m;  // waypoints, at least one
+  std::vector<double> z_m;   // tool bottom z per waypoint; empty: surface - depth
+  double spacing_m = 0.005;  // arc length between stamps
+  int repeat = 1;            // trace the whole stroke this many times
 };
 
 struct StampSchedule {
   std::vector<ToolStamp> stamps;
-  double length_m = 0.0;          // arc length of one trace
+  double length_m = 0.0;  // arc length of one trace
 };
 
 // Arc-length positions 0, s, 2s, ... along the polyline, plus its end when the last gap is

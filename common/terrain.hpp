@@ -26,7 +26,7 @@ struct StampReport {
 };
 
 struct ErosionBudget {
-  int max_passes = 4;  // passes over the active set in this call
+  int max_passes = 4;                                                 // passes over the active set in this call
   std::size_t max_updates = std::numeric_limits<std::size_t>::max();  // element visits
 };
 
@@ -45,8 +45,8 @@ struct SimplifyParams {
 struct SimplifyReport {
   std::size_t candidates = 0;  // vertices examined (the paper's L_r)
   std::size_t removed = 0;
-  double detect_s = 0.0;       // redundant-vertex detection time
-  double remove_s = 0.0;       // vertex removal time
+  double detect_s = 0.0;  // redundant-vertex detection time
+  double remove_s = 0.0;  // vertex removal time
 };
 
 struct ModelStats {
@@ -54,9 +54,9 @@ struct ModelStats {
   std::size_t triangles = 0;
   std::size_t constrained_edges = 0;
   std::size_t cells = 0;
-  std::size_t bytes = 0;       // the model's own data, from its containers' capacities
+  std::size_t bytes = 0;         // the model's own data, from its containers' capacities
   std::uint64_t walk_steps = 0;  // point-location steps since construction (TIN)
-  std::size_t active = 0;      // erosion active set (L_e) size
+  std::size_t active = 0;        // erosion active set (L_e) size
 };
 
 // Triangles of a back-end's surface, for rendering and export.

@@ -8,18 +8,21 @@ namespace sb {
 
 std::string to_string(ToolShape s) {
   switch (s) {
-    case ToolShape::Disk: return "disk";
-    case ToolShape::Box: return "box";
-    case ToolShape::Ellipse: return "ellipse";
-    case ToolShape::Polygon: return "polygon";
-    case ToolShape::Pour: return "pour";
+    case ToolShape::Disk:
+      return "disk";
+    case ToolShape::Box:
+      return "box";
+    case ToolShape::Ellipse:
+      return "ellipse";
+    case ToolShape::Polygon:
+      return "polygon";
+    case ToolShape::Pour:
+      return "pour";
   }
   return "?";
 }
 
-std::string to_string(BottomProfile p) {
-  return p == BottomProfile::Flat ? "flat" : "sphere_cap";
-}
+std::string to_string(BottomProfile p) { return p == BottomProfile::Flat ? "flat" : "sphere_cap"; }
 
 std::vector<Vec2> ToolSpec::footprint_local() const {
   std::vector<Vec2> poly;
@@ -30,15 +33,22 @@ std::vector<Vec2> ToolSpec::footprint_local() const {
     }
   };
   switch (shape) {
-    case ToolShape::Disk: ngon(radius_m, radius_m); break;
-    case ToolShape::Ellipse: ngon(half_size_m.x(), half_size_m.y()); break;
+    case ToolShape::Disk:
+      ngon(radius_m, radius_m);
+      break;
+    case ToolShape::Ellipse:
+      ngon(half_size_m.x(), half_size_m.y());
+      break;
     case ToolShape::Box: {
       const double hx = half_size_m.x(), hy = half_size_m.y();
       poly = {{-hx, -hy}, {hx, -hy}, {hx, hy}, {-hx, hy}};
       break;
     }
-    case ToolShape::Polygon: poly = make_ccw(polygon_m); break;
-    case ToolShape::Pour: break;
+    case ToolShape::Polygon:
+      poly = make_ccw(polygon_m);
+      break;
+    case ToolShape::Pour:
+      break;
   }
   return poly;
 }
@@ -75,8 +85,7 @@ Aabb2 ToolStamp::influence_bounds() const {
   return bounds(footprint).expanded(rim.width_m);
 }
 
-ToolStamp make_stamp(const ToolSpec& spec, const ToolPose& pose, const Vec2& motion_dir,
-                     std::uint32_t generation) {
+ToolStamp make_stamp(const ToolSpec& spec, const ToolPose& pose, const Vec2& motion_dir, std::uint32_t generation) {
   ToolStamp s;
   s.generation = generation;
   s.pose = pose;
@@ -91,8 +100,7 @@ ToolStamp make_stamp(const ToolSpec& spec, const ToolPose& pose, const Vec2& mot
   }
   const double c = std::cos(pose.heading_rad), sn = std::sin(pose.heading_rad);
   for (const Vec2& q : spec.footprint_local()) {
-    s.footprint.emplace_back(pose.xy.x() + c * q.x() - sn * q.y(),
-                             pose.xy.y() + sn * q.x() + c * q.y());
+    s.footprint.emplace_back(pose.xy.x() + c * q.x() - sn * q.y(), pose.xy.y() + sn * q.x() + c * q.y());
   }
   return s;
 }

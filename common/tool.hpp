@@ -24,14 +24,14 @@ struct RimRule {
 
 struct ToolSpec {
   ToolShape shape = ToolShape::Disk;
-  double radius_m = 0.02;            // disk radius; pour radius for the pour tool
-  Vec2 half_size_m{0.02, 0.01};      // box half sizes; ellipse semi-axes
-  std::vector<Vec2> polygon_m;       // polygon footprint, tool coordinates
-  int sides = 32;                    // n-gon sides for disk and ellipse
+  double radius_m = 0.02;        // disk radius; pour radius for the pour tool
+  Vec2 half_size_m{0.02, 0.01};  // box half sizes; ellipse semi-axes
+  std::vector<Vec2> polygon_m;   // polygon footprint, tool coordinates
+  int sides = 32;                // n-gon sides for disk and ellipse
   BottomProfile profile = BottomProfile::Flat;
-  double sphere_radius_m = 0.05;     // sphere-cap profile: sphere radius
-  double depth_m = 0.01;             // bottom depth below the initial surface
-  double pour_volume_m3 = 0.0;       // pour tool: volume added per stamp
+  double sphere_radius_m = 0.05;  // sphere-cap profile: sphere radius
+  double depth_m = 0.01;          // bottom depth below the initial surface
+  double pour_volume_m3 = 0.0;    // pour tool: volume added per stamp
   RimRule rim;
 
   // Footprint in tool coordinates (origin at the pose, x along the heading), CCW.
@@ -41,19 +41,19 @@ struct ToolSpec {
 
 struct ToolPose {
   Vec2 xy{0.0, 0.0};
-  double bottom_z = 0.0;    // lowest point of the tool bottom, m
-  double heading_rad = 0.0; // rotation of the footprint about z
+  double bottom_z = 0.0;     // lowest point of the tool bottom, m
+  double heading_rad = 0.0;  // rotation of the footprint about z
 };
 
 struct ToolStamp {
   std::uint32_t generation = 0;  // stamp index in its schedule, from 0
   ToolPose pose;
-  Vec2 motion_dir{0.0, 0.0};     // unit direction of motion; zero for a stationary stamp
-  std::vector<Vec2> footprint;   // world coordinates, CCW; empty for a pour
+  Vec2 motion_dir{0.0, 0.0};    // unit direction of motion; zero for a stationary stamp
+  std::vector<Vec2> footprint;  // world coordinates, CCW; empty for a pour
   BottomProfile profile = BottomProfile::Flat;
   double sphere_radius_m = 0.0;
   RimRule rim;
-  double pour_volume_m3 = 0.0;   // > 0 only for pours
+  double pour_volume_m3 = 0.0;  // > 0 only for pours
   double pour_radius_m = 0.0;
 
   bool is_pour() const { return pour_volume_m3 > 0.0; }
@@ -69,7 +69,6 @@ struct ToolStamp {
 };
 
 // Places a tool at a pose: transforms the footprint into the world.
-ToolStamp make_stamp(const ToolSpec& spec, const ToolPose& pose, const Vec2& motion_dir,
-                     std::uint32_t generation);
+ToolStamp make_stamp(const ToolSpec& spec, const ToolPose& pose, const Vec2& motion_dir, std::uint32_t generation);
 
 }  // namespace sb

@@ -18,8 +18,7 @@ std::span<const std::uint32_t> ActiveSet::begin_pass() {
 }
 
 std::size_t ActiveSet::bytes() const {
-  return state_.capacity() * sizeof(std::uint16_t) +
-         (list_.capacity() + visiting_.capacity()) * sizeof(std::uint32_t);
+  return state_.capacity() * sizeof(std::uint16_t) + (list_.capacity() + visiting_.capacity()) * sizeof(std::uint32_t);
 }
 
 void ActiveSet::check(std::vector<std::string>& problems) const {
@@ -46,8 +45,8 @@ void ActiveSet::check(std::vector<std::string>& problems) const {
     if (!(state_[k] & kMember)) problems.push_back("active set: node " + std::to_string(k) + " listed but not flagged");
   }
   if (flagged != list_.size())
-    problems.push_back("active set: " + std::to_string(flagged) + " nodes flagged, " +
-                       std::to_string(list_.size()) + " listed");
+    problems.push_back("active set: " + std::to_string(flagged) + " nodes flagged, " + std::to_string(list_.size()) +
+                       " listed");
 }
 
 }  // namespace sb::grid

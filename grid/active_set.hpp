@@ -61,8 +61,8 @@ class ActiveSet {
  private:
   static constexpr std::uint16_t kMember = 0x8000;
   int idle_passes_;
-  std::vector<std::uint16_t> state_;   // kMember | idle count, per node
-  std::vector<std::uint32_t> list_;    // members, in visiting order
+  std::vector<std::uint16_t> state_;     // kMember | idle count, per node
+  std::vector<std::uint32_t> list_;      // members, in visiting order
   std::vector<std::uint32_t> visiting_;  // the pass in progress
 };
 

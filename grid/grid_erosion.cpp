@@ -6,8 +6,8 @@
 namespace sb::grid {
 
 template <class Real>
-ErosionReport erode_grid(HeightGrid<Real>& grid, ActiveSet& active, const Stencil& stencil,
-                         const ErosionRule& rule, const ErosionBudget& budget) {
+ErosionReport erode_grid(HeightGrid<Real>& grid, ActiveSet& active, const Stencil& stencil, const ErosionRule& rule,
+                         const ErosionBudget& budget) {
   const GridLayout& layout = grid.layout();
   ErosionReport report;
   CompensatedSum moved;

@@ -14,7 +14,7 @@ namespace sb::grid {
 
 // Runs passes over `active` until it is empty or the budget is spent.
 template <class Real>
-ErosionReport erode_grid(HeightGrid<Real>& grid, ActiveSet& active, const Stencil& stencil,
-                         const ErosionRule& rule, const ErosionBudget& budget);
+ErosionReport erode_grid(HeightGrid<Real>& grid, ActiveSet& active, const Stencil& stencil, const ErosionRule& rule,
+                         const ErosionBudget& budget);
 
 }  // namespace sb::grid

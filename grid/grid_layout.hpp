@@ -41,9 +41,7 @@ struct GridLayout {
   Aabb2 box() const {
     return {origin, origin + Vec2(dx * static_cast<double>(nx - 1), dy * static_cast<double>(ny - 1))};
   }
-  std::uint32_t index(std::size_t ix, std::size_t iy) const {
-    return static_cast<std::uint32_t>(iy * nx + ix);
-  }
+  std::uint32_t index(std::size_t ix, std::size_t iy) const { return static_cast<std::uint32_t>(iy * nx + ix); }
   Vec2 position(std::size_t ix, std::size_t iy) const {
     return {origin.x() + dx * static_cast<double>(ix), origin.y() + dy * static_cast<double>(iy)};
   }

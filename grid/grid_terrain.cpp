@@ -22,7 +22,8 @@ StampReport GridTerrain<Real>::stamp(const ToolStamp& s) {
   for (std::uint32_t k : changed) {
     active_.activate(k);
     const auto [ix, iy] = layout.split(k);
-    stencil_.for_each(layout, ix, iy, [&](std::size_t jx, std::size_t jy, int) { active_.activate(layout.index(jx, jy)); });
+    stencil_.for_each(layout, ix, iy,
+                      [&](std::size_t jx, std::size_t jy, int) { active_.activate(layout.index(jx, jy)); });
   }
   return report;
 }

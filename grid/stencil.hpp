@@ -13,8 +13,8 @@ namespace sb::grid {
 
 struct Stencil {
   int size = 8;
-  std::array<int, 8> ox{}, oy{};         // index offsets
-  std::array<double, 8> distance_m{};    // horizontal distance to the neighbour
+  std::array<int, 8> ox{}, oy{};       // index offsets
+  std::array<double, 8> distance_m{};  // horizontal distance to the neighbour
 
   static Stencil make(const GridLayout& layout, int neighbours) {
     if (neighbours != 4 && neighbours != 8)

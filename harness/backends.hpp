@@ -12,7 +12,6 @@ namespace sb {
 
 std::vector<std::string> backend_names();  // {"tin", "grid"}
 // Throws InputError for an unknown name.
-std::unique_ptr<Terrain> make_terrain(const std::string& backend, const Scene& scene,
-                                      const HeightField& initial);
+std::unique_ptr<Terrain> make_terrain(const std::string& backend, const Scene& scene, const HeightField& initial);
 
 }  // namespace sb

@@ -34,10 +34,25 @@ std::vector<std::string> split(const std::string& s, char sep) {
 }
 
 std::string markdown_table(const std::vector<VariantRun>& runs) {
-  static const char* rows[] = {"stamps", "time_s.tool", "time_s.erosion", "time_s.simplify", "time_s.total",
-                               "step_ms.p50", "step_ms.p95", "step_ms.max", "memory_bytes", "memory_bytes_peak",
-                               "vertices", "triangles", "constrained_edges", "cells", "volume_initial",
-                               "volume_final", "volume_added", "volume_drift_rel", "max_slope_excess_deg"};
+  static const char* rows[] = {"stamps",
+                               "time_s.tool",
+                               "time_s.erosion",
+                               "time_s.simplify",
+                               "time_s.total",
+                               "step_ms.p50",
+                               "step_ms.p95",
+                               "step_ms.max",
+                               "memory_bytes",
+                               "memory_bytes_peak",
+                               "vertices",
+                               "triangles",
+                               "constrained_edges",
+                               "cells",
+                               "volume_initial",
+                               "volume_final",
+                               "volume_added",
+                               "volume_drift_rel",
+                               "max_slope_excess_deg"};
   std::ostringstream t;
   t << "| metric |";
   for (const auto& r : runs) t << " " << r.run.label << " |";
@@ -49,8 +64,10 @@ std::string markdown_table(const std::vector<VariantRun>& runs) {
     for (const auto& r : runs) {
       const Json& v = r.summary.at(row);
       std::ostringstream cell;
-      if (v.is_number_float()) cell << std::setprecision(6) << v.get<double>();
-      else cell << v.dump();
+      if (v.is_number_float())
+        cell << std::setprecision(6) << v.get<double>();
+      else
+        cell << v.dump();
       t << " " << cell.str() << " |";
     }
     t << "\n";
@@ -78,17 +95,19 @@ void compare_command(const CompareOptions& o) {
   report["differences"] = Json::array();
   for (std::size_t i = 1; i < runs.size(); ++i) {
     const RasterDifference d = compare_rasters(runs[i].run.final_raster, runs[0].run.final_raster);
-    report["differences"].push_back({{"a", runs[i].run.label}, {"b", runs[0].run.label},
-                                     {"rmse_m", d.rmse_m}, {"max_abs_m", d.max_abs_m}, {"mean_m", d.mean_m}});
+    report["differences"].push_back({{"a", runs[i].run.label},
+                                     {"b", runs[0].run.label},
+                                     {"rmse_m", d.rmse_m},
+                                     {"max_abs_m", d.max_abs_m},
+                                     {"mean_m", d.mean_m}});
   }
 
   const std::string table = markdown_table(runs);
   if (!dir.empty()) {
     for (const auto& r : runs)
       write_run_file(dir / default_run_path(o.scene, r.run.label).filename(), r.run, r.prepared, r.summary);
-    write_atomically(dir / "summary.json", [&](const std::filesystem::path& tmp) {
-      std::ofstream(tmp) << report.dump(2) << "\n";
-    });
+    write_atomically(dir / "summary.json",
+                     [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << report.dump(2) << "\n"; });
     write_atomically(dir / "table.md", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << table; });
     std::vector<PictureRun> pictures;
     for (const auto& r : runs)
@@ -111,7 +130,8 @@ void add_compare_command(CLI::App& app) {
   cmd->add_option("scene", opts->scene, "Scene file (TOML)")->required();
   cmd->add_option("--backends", opts->backends,
                   "Comma-separated back-ends or variants (default tin,grid), e.g. grid,grid:grid.storage=float");
-  cmd->add_option("--out", opts->out, "Directory for run files, summary.json, table.md, side_by_side.png and difference.png");
+  cmd->add_option("--out", opts->out,
+                  "Directory for run files, summary.json, table.md, side_by_side.png and difference.png");
   cmd->add_flag("--json", opts->json, "Print the report as JSON on stdout");
   cmd->add_option("--set", opts->overrides, "Override a scene key: --set tool.radius_m=0.03")->take_all();
   cmd->callback([opts] { compare_command(*opts); });

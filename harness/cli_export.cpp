@@ -32,20 +32,22 @@ void export_command(const ExportOptions& o) {
   if (std::filesystem::is_directory(out)) throw InputError("-o " + out.string() + " is a directory; give a file name");
   const RunFile run = read_run_file(o.run);
   const std::string label = attribute(run, "label").empty() ? attribute(run, "backend") : attribute(run, "label");
-  const std::vector<std::string> comments = {std::string("sandbench ") + kVersion + " export of " +
-                                                 std::filesystem::path(o.run).filename().string(),
-                                             "backend " + label, "scene " + attribute(run, "scene_path")};
+  const std::vector<std::string> comments = {
+      std::string("sandbench ") + kVersion + " export of " + std::filesystem::path(o.run).filename().string(),
+      "backend " + label, "scene " + attribute(run, "scene_path")};
   if (format == ExportFormat::Png16) {
     const HeightmapKeys k = export_png16(out, run.final_raster, comments[0] + ", backend " + label);
-    std::cerr << "wrote " << out.string() << " (" << run.final_raster.nx << " x " << run.final_raster.ny
-              << ", step " << k.step_m() << " m) and " << out.string() << ".aux.xml\nreload it with:\n"
+    std::cerr << "wrote " << out.string() << " (" << run.final_raster.nx << " x " << run.final_raster.ny << ", step "
+              << k.step_m() << " m) and " << out.string() << ".aux.xml\nreload it with:\n"
               << heightmap_scene_snippet(k, out.filename().string());
     return;
   }
   const SurfaceMesh mesh = run.mesh.triangles.empty() ? mesh_from_raster(run.final_raster) : run.mesh;
   if (run.mesh.triangles.empty()) std::cerr << "sandbench: " << o.run << " has no mesh; exporting its final raster\n";
-  if (format == ExportFormat::Ply) export_ply(out, mesh, comments);
-  else export_obj(out, mesh, comments);
+  if (format == ExportFormat::Ply)
+    export_ply(out, mesh, comments);
+  else
+    export_obj(out, mesh, comments);
   std::cerr << "wrote " << out.string() << " (" << mesh.vertices.size() << " vertices, " << mesh.triangles.size()
             << " triangles, " << mesh.constrained_edges.size() << " constrained edges)\n";
 }
@@ -53,7 +55,8 @@ void export_command(const ExportOptions& o) {
 
 void add_export_command(CLI::App& app) {
   auto opts = std::make_shared<ExportOptions>();
-  CLI::App* cmd = app.add_subcommand("export", "Export a run file's final surface as PLY, OBJ or a 16-bit PNG heightmap");
+  CLI::App* cmd =
+      app.add_subcommand("export", "Export a run file's final surface as PLY, OBJ or a 16-bit PNG heightmap");
   cmd->add_option("run", opts->run, "Run file (HDF5) written by sandbench run or compare")->required();
   cmd->add_option("--format", opts->format, "ply | obj | png16")->required();
   cmd->add_option("-o,--out", opts->out, "File to write")->required();

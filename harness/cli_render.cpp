@@ -36,16 +36,20 @@ int parse_dimension(const std::string& text, const std::string& whole) {
 void render_command(const RenderCliOptions& o) {
   RenderOptions options;
   const auto x = o.size.find('x');
-  if (x == std::string::npos)
-    throw InputError("--size \"" + o.size + "\": must be WxH, e.g. 1024x768");
+  if (x == std::string::npos) throw InputError("--size \"" + o.size + "\": must be WxH, e.g. 1024x768");
   options.width = parse_dimension(o.size.substr(0, x), o.size);
   options.height = parse_dimension(o.size.substr(x + 1), o.size);
-  if (o.view == "oblique") options.view = View::Oblique;
-  else if (o.view == "top") options.view = View::Top;
-  else throw InputError("--view \"" + o.view + "\": must be oblique or top");
+  if (o.view == "oblique")
+    options.view = View::Oblique;
+  else if (o.view == "top")
+    options.view = View::Top;
+  else
+    throw InputError("--view \"" + o.view + "\": must be oblique or top");
   FrameRegion region = FrameRegion::Changed;
-  if (o.region == "domain") region = FrameRegion::Domain;
-  else if (o.region != "changed") throw InputError("--region \"" + o.region + "\": must be changed or domain");
+  if (o.region == "domain")
+    region = FrameRegion::Domain;
+  else if (o.region != "changed")
+    throw InputError("--region \"" + o.region + "\": must be changed or domain");
   options.wireframe = o.wireframe;
   options.contours = o.contours;
   const std::filesystem::path out = o.out;
@@ -55,8 +59,7 @@ void render_command(const RenderCliOptions& o) {
 
   const RunFile run = read_run_file(o.run);
   const RenderFrame frame = make_frame({{&run.initial_raster, &run.final_raster}}, region);
-  if (run.mesh.triangles.empty())
-    std::cerr << "sandbench: " << o.run << " has no mesh; drawing its final raster\n";
+  if (run.mesh.triangles.empty()) std::cerr << "sandbench: " << o.run << " has no mesh; drawing its final raster\n";
   Renderer renderer;
   write_png(out, render_picture(renderer, run.mesh, run.final_raster, frame, options));
   std::cerr << "wrote " << out.string() << "\n";

@@ -35,7 +35,8 @@ void run_command(const RunOptions& o) {
     prepared.scene.reference = ReferenceKind::None;  // the analytic references follow the scene's stroke
   }
   const Variant variant = parse_variant(o.backend);
-  const std::filesystem::path out = o.out.empty() ? default_run_path(o.scene, variant.label) : std::filesystem::path(o.out);
+  const std::filesystem::path out =
+      o.out.empty() ? default_run_path(o.scene, variant.label) : std::filesystem::path(o.out);
   if (out.has_parent_path() && !std::filesystem::is_directory(out.parent_path()))
     throw InputError("--out " + out.string() + ": directory " + out.parent_path().string() + " does not exist");
   VariantRun r = run_variant(variant, prepared, /*show_progress=*/true);

@@ -26,7 +26,8 @@ Variant parse_variant(const std::string& text) {
   v.backend = text.substr(0, colon);
   const auto names = backend_names();
   if (std::find(names.begin(), names.end(), v.backend) == names.end())
-    throw InputError("--backends: \"" + v.backend + "\" is not a back-end; must be tin or grid, optionally "
+    throw InputError("--backends: \"" + v.backend +
+                     "\" is not a back-end; must be tin or grid, optionally "
                      "followed by :key=value overrides (e.g. grid:grid.storage=float)");
   if (colon == std::string::npos) return v;
   start = colon + 1;
@@ -47,16 +48,16 @@ VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_pr
   overrides.insert(overrides.end(), v.overrides.begin(), v.overrides.end());
   Scene scene = base.scene;
   if (!v.overrides.empty()) {
-    scene = parse_scene(base.scene.text, base.scene.path, overrides,
-                        std::filesystem::path(base.scene.path).parent_path());
+    scene =
+        parse_scene(base.scene.text, base.scene.path, overrides, std::filesystem::path(base.scene.path).parent_path());
   }
   PreparedScene prepared = base;
   prepared.scene = scene;
   prepared.rule = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg);
 
   auto terrain = make_terrain(v.backend, prepared.scene, prepared.initial);
-  VariantRun out{run_schedule(*terrain, prepared, show_progress ? terminal_progress(v.label) : ProgressFn{}),
-                 prepared, {}};
+  VariantRun out{
+      run_schedule(*terrain, prepared, show_progress ? terminal_progress(v.label) : ProgressFn{}), prepared, {}};
   out.run.label = v.label;
   out.summary = summarize(out.run, prepared);
   return out;

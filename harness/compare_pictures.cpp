@@ -212,7 +212,8 @@ Image difference_map(const std::vector<PictureRun>& runs, const RenderFrame& fra
     draw_text(image, x, kMargin + title_h + text_height(3) + 6,
               "RMSE " + metres(d.rmse_m) + ", max |d| " + metres(d.max_abs_m), kInk, 2);
     heat_map(image, x, map_y, map_w, map_h, *a.final, base, frame, scale_m);
-    draw_text(image, x + map_w / 2 - text_width("x (m)", 2) / 2, map_y + map_h + text_height(2) + 16, "x (m)", kGrey, 2);
+    draw_text(image, x + map_w / 2 - text_width("x (m)", 2) / 2, map_y + map_h + text_height(2) + 16, "x (m)", kGrey,
+              2);
     draw_text(image, x - left + 4, map_y - text_height(2) - 4, "y (m)", kGrey, 2);
   }
   draw_colour_bar(image, kMargin + panels * panel_w, map_y, bar, map_h * 3 / 4, 2, false);

@@ -19,11 +19,11 @@
 namespace sb {
 
 struct PictureRun {
-  std::string label;                // back-end or variant, e.g. "tin", "grid:grid.neighbours=4"
+  std::string label;  // back-end or variant, e.g. "tin", "grid:grid.neighbours=4"
   const SurfaceMesh* mesh = nullptr;
   const Raster* initial = nullptr;  // the common raster before and after the stroke
   const Raster* final = nullptr;
-  const Json* summary = nullptr;    // contract metrics: vertices, cells, memory_bytes, ...
+  const Json* summary = nullptr;  // contract metrics: vertices, cells, memory_bytes, ...
 };
 
 // The frame all pictures of a comparison share (FrameRegion::Changed over every run).

@@ -33,9 +33,9 @@ void export_obj(const std::filesystem::path& file, const SurfaceMesh& mesh, cons
 // How a raster maps to a 16-bit heightmap (the scene keys that reload it).
 struct HeightmapKeys {
   Vec2 origin_m{0.0, 0.0};
-  Vec2 size_m{0.0, 0.0};          // (nx - 1, ny - 1) * spacing
-  double height_m = 0.0;          // the lowest height (value 0)
-  double vertical_scale_m = 0.0;  // value 65535 is height_m + this
+  Vec2 size_m{0.0, 0.0};                                        // (nx - 1, ny - 1) * spacing
+  double height_m = 0.0;                                        // the lowest height (value 0)
+  double vertical_scale_m = 0.0;                                // value 65535 is height_m + this
   double step_m() const { return vertical_scale_m / 65535.0; }  // one quantisation step
 };
 HeightmapKeys heightmap_keys(const Raster& raster);

@@ -26,11 +26,16 @@ std::string pair(const Vec2& v) {
 std::string xml_escape(const std::string& s) {
   std::string out;
   for (char c : s) {
-    if (c == '&') out += "&amp;";
-    else if (c == '<') out += "&lt;";
-    else if (c == '>') out += "&gt;";
-    else if (c == '"') out += "&quot;";
-    else out += c;
+    if (c == '&')
+      out += "&amp;";
+    else if (c == '<')
+      out += "&lt;";
+    else if (c == '>')
+      out += "&gt;";
+    else if (c == '"')
+      out += "&quot;";
+    else
+      out += c;
   }
   return out;
 }
@@ -77,13 +82,13 @@ HeightmapKeys export_png16(const std::filesystem::path& file, const Raster& rast
   const double s = raster.spacing_m;
   // GDAL's sidecar: pixel-is-area georeference (pixel centres on the raster points), and the
   // scale and offset that turn values into metres.
-  const std::string aux =
-      "<PAMDataset>\n  <GeoTransform>" + number(k.origin_m.x() - s / 2) + ", " + number(s) + ", 0, " +
-      number(k.origin_m.y() + k.size_m.y() + s / 2) + ", 0, " + number(-s) +
-      "</GeoTransform>\n  <Metadata>\n    <MDI key=\"source\">" + xml_escape(source) +
-      "</MDI>\n  </Metadata>\n  <PAMRasterBand band=\"1\">\n    <Description>height</Description>\n"
-      "    <UnitType>m</UnitType>\n    <Offset>" + number(k.height_m) + "</Offset>\n    <Scale>" +
-      number(k.step_m()) + "</Scale>\n  </PAMRasterBand>\n</PAMDataset>\n";
+  const std::string aux = "<PAMDataset>\n  <GeoTransform>" + number(k.origin_m.x() - s / 2) + ", " + number(s) +
+                          ", 0, " + number(k.origin_m.y() + k.size_m.y() + s / 2) + ", 0, " + number(-s) +
+                          "</GeoTransform>\n  <Metadata>\n    <MDI key=\"source\">" + xml_escape(source) +
+                          "</MDI>\n  </Metadata>\n  <PAMRasterBand band=\"1\">\n    <Description>height</Description>\n"
+                          "    <UnitType>m</UnitType>\n    <Offset>" +
+                          number(k.height_m) + "</Offset>\n    <Scale>" + number(k.step_m()) +
+                          "</Scale>\n  </PAMRasterBand>\n</PAMDataset>\n";
   std::filesystem::path aux_file = file;
   aux_file += ".aux.xml";
   write_atomically(aux_file, [&](const std::filesystem::path& tmp) {
@@ -96,8 +101,9 @@ HeightmapKeys export_png16(const std::filesystem::path& file, const Raster& rast
     write_png16(file, png,
                 {{"Software", "sandbench"},
                  {"Source", source},
-                 {"Description", "sandbench heightmap: z = height_m + value / 65535 * vertical_scale_m (metres); "
-                                 "column 0 at origin x, row 0 at origin y + size y (maximum y)"},
+                 {"Description",
+                  "sandbench heightmap: z = height_m + value / 65535 * vertical_scale_m (metres); "
+                  "column 0 at origin x, row 0 at origin y + size y (maximum y)"},
                  {"sandbench.origin_m", pair(k.origin_m)},
                  {"sandbench.size_m", pair(k.size_m)},
                  {"sandbench.height_m", number(k.height_m)},

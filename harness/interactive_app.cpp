@@ -4,11 +4,11 @@
 // hands control changes to the simulation.
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
-#include <Eigen/Geometry>
 #include <backends/imgui_impl_glfw.h>
 #include <backends/imgui_impl_opengl3.h>
 #include <imgui.h>
 
+#include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -54,7 +54,7 @@ std::string default_record_path() {
 
 // Window input the callbacks collect between frames.
 struct WindowInput {
-  double scroll = 0.0;        // wheel notches
+  double scroll = 0.0;  // wheel notches
   bool ctrl_scroll = false;
 };
 
@@ -62,7 +62,8 @@ void scroll_callback(GLFWwindow* w, double, double dy) {
   if (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse) return;
   auto* in = static_cast<WindowInput*>(glfwGetWindowUserPointer(w));
   in->scroll += dy;
-  in->ctrl_scroll = glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS;
+  in->ctrl_scroll =
+      glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS;
 }
 
 void add_line(std::vector<LineVertex>& out, const Vec3& a, const Vec3& b, const Vec3& rgb) {
@@ -108,7 +109,8 @@ std::vector<LineVertex> tool_overlay(const ToolSpec& tool, double heading_rad, c
 
 struct GlfwSession {
   GlfwSession() {
-    glfwSetErrorCallback([](int code, const char* what) { std::cerr << "glfw: error " << code << ": " << what << "\n"; });
+    glfwSetErrorCallback(
+        [](int code, const char* what) { std::cerr << "glfw: error " << code << ": " << what << "\n"; });
     if (!glfwInit())
       throw std::runtime_error("cannot open a window: GLFW found no display (is DISPLAY set? headless: xvfb-run -a)");
   }
@@ -314,8 +316,8 @@ void run_interactive(const InteractiveOptions& o) {
   servo.stop();  // first: the simulation then drains every recorded sample
   sim.stop();
 
-  if (!o.screenshot.empty()) write_png_rgb(o.screenshot, static_cast<std::size_t>(shot_w),
-                                           static_cast<std::size_t>(shot_h), screenshot);
+  if (!o.screenshot.empty())
+    write_png_rgb(o.screenshot, static_cast<std::size_t>(shot_w), static_cast<std::size_t>(shot_h), screenshot);
   const haptics::ServoStats servo_stats = servo.stats();
   InteractiveRunInfo info;
   info.scene = o.scene;
@@ -323,7 +325,8 @@ void run_interactive(const InteractiveOptions& o) {
   info.device = o.device;
   info.frames = static_cast<std::uint64_t>(frame);
   info.wall_s = wall_s;
-  if (auto* replay = dynamic_cast<haptics::ReplayDevice*>(device.get())) info.device_force_max_n = replay->max_commanded_force_n();
+  if (auto* replay = dynamic_cast<haptics::ReplayDevice*>(device.get()))
+    info.device_force_max_n = replay->max_commanded_force_n();
   if (mouse_device) info.device_force_max_n = mouse_device->max_commanded_force_n();
   const Json stats = haptic_stats_json(servo_stats, limits, sim.totals(), info);
   if (!o.stats.empty()) write_json_file(o.stats, stats);

@@ -15,8 +15,8 @@ struct Ray {
 
 struct Camera {
   Vec3 target{0.0, 0.0, 0.0};
-  double yaw_rad = -2.356;      // looking along +x +y
-  double pitch_rad = 0.75;      // above the horizon
+  double yaw_rad = -2.356;  // looking along +x +y
+  double pitch_rad = 0.75;  // above the horizon
   double distance_m = 0.4;
   double fov_y_deg = 40.0;
 

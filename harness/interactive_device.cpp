@@ -62,7 +62,8 @@ haptics::DeviceLimits scene_device_limits(const HeightField& initial, double max
 
 std::unique_ptr<haptics::HapticDevice> make_device(const DeviceSpec& spec, const haptics::DeviceLimits& limits) {
   switch (spec.kind) {
-    case DeviceSpec::Kind::Mouse: return std::make_unique<haptics::SharedPoseDevice>("mouse", limits);
+    case DeviceSpec::Kind::Mouse:
+      return std::make_unique<haptics::SharedPoseDevice>("mouse", limits);
     case DeviceSpec::Kind::Replay: {
       haptics::Trajectory t;
       try {
@@ -72,7 +73,8 @@ std::unique_ptr<haptics::HapticDevice> make_device(const DeviceSpec& spec, const
       }
       return std::make_unique<haptics::ReplayDevice>(std::move(t), limits);
     }
-    case DeviceSpec::Kind::Udp: return std::make_unique<haptics::UdpDevice>(spec.port, limits, "--device " + spec.text);
+    case DeviceSpec::Kind::Udp:
+      return std::make_unique<haptics::UdpDevice>(spec.port, limits, "--device " + spec.text);
   }
   return nullptr;
 }

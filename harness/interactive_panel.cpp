@@ -16,9 +16,17 @@ ToolSpec panel_tool(ToolChoice choice, double size_m, const ToolSpec& scene_tool
   t.radius_m = size_m;
   t.half_size_m = Vec2(size_m, 0.5 * size_m);
   switch (choice) {
-    case ToolChoice::Disk: t.shape = ToolShape::Disk; break;
-    case ToolChoice::Box: t.shape = ToolShape::Box; t.rim.width_m = 0.25 * size_m; break;
-    case ToolChoice::Ellipse: t.shape = ToolShape::Ellipse; t.rim.width_m = 0.25 * size_m; break;
+    case ToolChoice::Disk:
+      t.shape = ToolShape::Disk;
+      break;
+    case ToolChoice::Box:
+      t.shape = ToolShape::Box;
+      t.rim.width_m = 0.25 * size_m;
+      break;
+    case ToolChoice::Ellipse:
+      t.shape = ToolShape::Ellipse;
+      t.rim.width_m = 0.25 * size_m;
+      break;
     case ToolChoice::Sphere:
       t.shape = ToolShape::Disk;
       t.profile = BottomProfile::SphereCap;
@@ -26,10 +34,11 @@ ToolSpec panel_tool(ToolChoice choice, double size_m, const ToolSpec& scene_tool
       break;
     case ToolChoice::Pour:
       t.shape = ToolShape::Pour;
-      t.pour_volume_m3 = scene_tool.shape == ToolShape::Pour ? scene_tool.pour_volume_m3
-                                                             : std::numbers::pi * size_m * size_m * 0.002;
+      t.pour_volume_m3 =
+          scene_tool.shape == ToolShape::Pour ? scene_tool.pour_volume_m3 : std::numbers::pi * size_m * size_m * 0.002;
       break;
-    case ToolChoice::Scene: break;
+    case ToolChoice::Scene:
+      break;
   }
   return t;
 }
@@ -52,8 +61,7 @@ PanelActions draw_panel(const PanelInput& in, SimControls& c, PanelState& state,
   ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
   ImGui::SetNextWindowSize(ImVec2(370, 0), ImGuiCond_FirstUseEver);
   ImGui::Begin("sandbench");
-  ImGui::Text("back-end %s   device %s%s", in.backend.c_str(), in.device.c_str(),
-              in.device_finished ? " (ended)" : "");
+  ImGui::Text("back-end %s   device %s%s", in.backend.c_str(), in.device.c_str(), in.device_finished ? " (ended)" : "");
   ImGui::TextDisabled("%s", in.scene.c_str());
 
   if (ImGui::CollapsingHeader("Model", ImGuiTreeNodeFlags_DefaultOpen)) {

@@ -15,15 +15,15 @@ enum class ToolChoice { Scene, Disk, Box, Ellipse, Sphere, Pour };
 // The window's own state that the panel edits.
 struct PanelState {
   ToolChoice tool = ToolChoice::Scene;
-  float tool_size_m = 0.02f;       // radius, or half the box/ellipse length
+  float tool_size_m = 0.02f;  // radius, or half the box/ellipse length
   bool wireframe = false;
   bool follow_tool = false;
-  std::string record_path;          // where the record button writes
+  std::string record_path;  // where the record button writes
 };
 
 struct PanelInput {
   std::string backend, device, scene;
-  bool device_finished = false;     // a replay that reached its end
+  bool device_finished = false;  // a replay that reached its end
   double mouse_depth_m = 0.0;
   bool mouse = false;
   const haptics::ServoState* servo = nullptr;

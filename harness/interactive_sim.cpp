@@ -24,9 +24,12 @@ std::string material_override(const char* key, double v) {
 
 }  // namespace
 
-Simulation::Simulation(const PreparedScene& prepared, std::unique_ptr<Terrain> terrain,
-                       haptics::PatchBuffer& patches, haptics::ServoLoop& servo, std::string backend)
-    : prepared_(prepared), terrain_(std::move(terrain)), patches_(patches), servo_(servo),
+Simulation::Simulation(const PreparedScene& prepared, std::unique_ptr<Terrain> terrain, haptics::PatchBuffer& patches,
+                       haptics::ServoLoop& servo, std::string backend)
+    : prepared_(prepared),
+      terrain_(std::move(terrain)),
+      patches_(patches),
+      servo_(servo),
       backend_(std::move(backend)) {
   active_.material = prepared.scene.material;
   active_.tool = prepared.scene.tool;
@@ -137,8 +140,7 @@ void Simulation::step() {
     double erosion_ms = 0.0, simplify_ms = 0.0;
     if (active_.erosion && (stamped || active_set_ > 0)) {
       sw.restart();
-      const ErosionReport er =
-          terrain_->erode(rule_, ErosionBudget{active_.erosion_passes, active_.erosion_updates});
+      const ErosionReport er = terrain_->erode(rule_, ErosionBudget{active_.erosion_passes, active_.erosion_updates});
       erosion_ms = 1e3 * sw.seconds();
       active_set_ = er.active;
       changed |= er.transfers > 0;

@@ -26,8 +26,8 @@ struct SimControls {
   bool paused = false;
   bool erosion = true;
   bool simplify = true;
-  int erosion_passes = 4;                // per step
-  std::size_t erosion_updates = 20000;   // per step: element visits
+  int erosion_passes = 4;               // per step
+  std::size_t erosion_updates = 20000;  // per step: element visits
 };
 
 // What the window shows; copied out under the mutex at display rate.
@@ -36,18 +36,18 @@ struct SimStatus {
   double volume_m3 = 0.0, volume_initial_m3 = 0.0, volume_added_m3 = 0.0;
   std::uint64_t steps = 0, stamps = 0, patches = 0;
   double tool_ms = 0.0, erosion_ms = 0.0, simplify_ms = 0.0, patch_ms = 0.0;  // last working step
-  double step_ms_p50 = 0.0, step_ms_p95 = 0.0;                              // last 256 working steps
-  double tool_heading_rad = 0.0;         // footprint rotation of the current tool
+  double step_ms_p50 = 0.0, step_ms_p95 = 0.0;                                // last 256 working steps
+  double tool_heading_rad = 0.0;                                              // footprint rotation of the current tool
   bool recording = false;
   std::size_t recorded_samples = 0, recorded_stamps = 0;
-  std::string message;                   // e.g. "wrote session.csv"
+  std::string message;  // e.g. "wrote session.csv"
 };
 
 // Whole-run figures for the statistics file.
 struct SimTotals {
   std::uint64_t steps = 0, stamps = 0, patches = 0;
-  std::vector<double> step_ms;           // every working step: stamp + erode + simplify
-  std::vector<double> patch_ms;          // every publication
+  std::vector<double> step_ms;   // every working step: stamp + erode + simplify
+  std::vector<double> patch_ms;  // every publication
   ModelStats final_stats;
   double volume_initial_m3 = 0.0, volume_final_m3 = 0.0, volume_added_m3 = 0.0;
 };
@@ -109,10 +109,10 @@ class Simulation {
   Vec2 last_stamp_xy_{0.0, 0.0};
   double last_stamp_z_ = 0.0, last_stamp_t_ = 0.0, heading_rad_ = 0.0;
   std::uint32_t generation_ = 0;
-  bool dirty_ = false;                  // terrain changed since the last display snapshot
-  std::size_t active_set_ = 1;          // erosion active set after the last erode (1: unknown)
+  bool dirty_ = false;          // terrain changed since the last display snapshot
+  std::size_t active_set_ = 1;  // erosion active set after the last erode (1: unknown)
   double last_display_s_ = -1.0;
-  std::vector<double> recent_ms_;       // ring of the last working steps
+  std::vector<double> recent_ms_;  // ring of the last working steps
   std::size_t recent_next_ = 0;
   SimTotals totals_;
   Session session_;
@@ -125,7 +125,7 @@ class Simulation {
   std::atomic<bool> controls_changed_{false};
   std::atomic<int> record_request_{0};  // 1 start, -1 stop
 
-  mutable std::mutex mutex_;            // guards the members below (never taken by the servo)
+  mutable std::mutex mutex_;  // guards the members below (never taken by the servo)
   SimControls controls_;
   SimStatus status_;
   std::shared_ptr<const DisplayMesh> mesh_;

@@ -14,12 +14,12 @@ namespace sb {
 struct InteractiveRunInfo {
   std::string scene, backend, device;
   std::uint64_t frames = 0;
-  double wall_s = 0.0;                 // window open time
-  double device_force_max_n = -1.0;    // as the device saw it (replay, mouse); < 0: unknown
+  double wall_s = 0.0;               // window open time
+  double device_force_max_n = -1.0;  // as the device saw it (replay, mouse); < 0: unknown
 };
 
-Json haptic_stats_json(const haptics::ServoStats& servo, const haptics::DeviceLimits& limits,
-                       const SimTotals& sim, const InteractiveRunInfo& info);
+Json haptic_stats_json(const haptics::ServoStats& servo, const haptics::DeviceLimits& limits, const SimTotals& sim,
+                       const InteractiveRunInfo& info);
 // Whole or not at all.
 void write_json_file(const std::filesystem::path& file, const Json& json);
 

@@ -1,9 +1,9 @@
 #include "harness/render.hpp"
 
 #define GL_GLEXT_PROTOTYPES 1
-#include <GL/osmesa.h>
 #include <GL/gl.h>
 #include <GL/glext.h>
+#include <GL/osmesa.h>
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -23,7 +23,7 @@ namespace {
 using Mat4 = Eigen::Matrix4d;
 
 constexpr double kDeg = std::numbers::pi / 180.0;
-constexpr double kViewBearingDeg = 160.0;   // camera position, clockwise from north (+y)
+constexpr double kViewBearingDeg = 160.0;  // camera position, clockwise from north (+y)
 constexpr double kViewElevationDeg = 40.0;
 constexpr double kFovYDeg = 30.0;
 constexpr double kMaxPixels = 48e6;  // drawn pixels (supersampled); larger pictures get less supersampling
@@ -176,8 +176,10 @@ Mat4 camera(const RenderFrame& frame, const Vec3& c, View view, double aspect) {
   if (view == View::Top) {
     const Vec2 mid = (lo + hi) / 2.0, half = (hi - lo) / 2.0;
     double hw = half.x(), hh = half.y();
-    if (hw < hh * aspect) hw = hh * aspect;
-    else hh = hw / aspect;
+    if (hw < hh * aspect)
+      hw = hh * aspect;
+    else
+      hh = hw / aspect;
     const double eye_z = z_hi + reach;
     Mat4 view_m = Mat4::Identity();
     view_m(0, 3) = -mid.x();
@@ -223,8 +225,10 @@ Mat4 camera(const RenderFrame& frame, const Vec3& c, View view, double aspect) {
   double ax = 0.0, ay = 0.0;
   for (int i = 0; i < 60; ++i) {
     const double mid = (near_d + far_d) / 2.0;
-    if (offset(mid, 0, tan_x, ax) && offset(mid, 1, tan_y, ay)) far_d = mid;
-    else near_d = mid;
+    if (offset(mid, 0, tan_x, ax) && offset(mid, 1, tan_y, ay))
+      far_d = mid;
+    else
+      near_d = mid;
   }
   offset(far_d, 0, tan_x, ax);
   offset(far_d, 1, tan_y, ay);
@@ -285,9 +289,21 @@ struct Renderer::Gl {
 };
 
 Renderer::Renderer() : gl_(std::make_unique<Gl>()) {
-  const int attribs[] = {OSMESA_FORMAT, OSMESA_RGBA, OSMESA_DEPTH_BITS, 24, OSMESA_STENCIL_BITS, 0,
-                         OSMESA_ACCUM_BITS, 0, OSMESA_PROFILE, OSMESA_COMPAT_PROFILE,
-                         OSMESA_CONTEXT_MAJOR_VERSION, 2, OSMESA_CONTEXT_MINOR_VERSION, 1, 0};
+  const int attribs[] = {OSMESA_FORMAT,
+                         OSMESA_RGBA,
+                         OSMESA_DEPTH_BITS,
+                         24,
+                         OSMESA_STENCIL_BITS,
+                         0,
+                         OSMESA_ACCUM_BITS,
+                         0,
+                         OSMESA_PROFILE,
+                         OSMESA_COMPAT_PROFILE,
+                         OSMESA_CONTEXT_MAJOR_VERSION,
+                         2,
+                         OSMESA_CONTEXT_MINOR_VERSION,
+                         1,
+                         0};
   gl_->context = OSMesaCreateContextAttribs(attribs, nullptr);
   if (!gl_->context) throw std::runtime_error("renderer: OSMesa cannot create an OpenGL 2.1 context");
   // Shaders, the colour map and the size limit need a current context: a 1 x 1 buffer.
@@ -333,7 +349,8 @@ Image Renderer::render(const SurfaceMesh& mesh, const RenderFrame& frame, const 
   const int w = o.width * ss, h = o.height * ss;
   gl_->buffer.assign(static_cast<std::size_t>(w) * h * 4, 0);
   if (!OSMesaMakeCurrent(gl_->context, gl_->buffer.data(), GL_UNSIGNED_BYTE, w, h))
-    throw std::runtime_error("renderer: OSMesa cannot use a " + std::to_string(w) + "x" + std::to_string(h) + " buffer");
+    throw std::runtime_error("renderer: OSMesa cannot use a " + std::to_string(w) + "x" + std::to_string(h) +
+                             " buffer");
 
   const Vec2 mid = (frame.region.lo + frame.region.hi) / 2.0;
   const RenderMesh rm =

@@ -24,7 +24,7 @@ struct RenderOptions {
   bool wireframe = false;
   bool contours = false;  // height colour map; contour lines at (k + 1/2) * frame.contour_step_m
   int width = 1024, height = 768;
-  int supersample = 2;    // lowered when the drawn size would exceed the GL limit or 48 Mpixel
+  int supersample = 2;  // lowered when the drawn size would exceed the GL limit or 48 Mpixel
 };
 
 // The light: from the north-west, 45 degrees above the horizon (GIS hillshade convention);

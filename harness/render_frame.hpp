@@ -10,9 +10,9 @@
 namespace sb {
 
 struct RenderFrame {
-  Aabb2 domain;             // the whole raster's extent
-  Aabb2 region;             // the part shown (inside domain)
-  double z_min_m = 0.0;     // lowest and highest height inside region, over all surfaces
+  Aabb2 domain;          // the whole raster's extent
+  Aabb2 region;          // the part shown (inside domain)
+  double z_min_m = 0.0;  // lowest and highest height inside region, over all surfaces
   double z_max_m = 0.0;
   double contour_step_m = 0.0;  // a nice step giving 8 to 15 contour levels
 };

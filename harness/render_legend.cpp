@@ -25,7 +25,8 @@ int bar_width(int scale) { return 8 * scale + 6; }
 
 BoxSize colour_bar_size(const ColourBar& bar, int bar_height, int scale) {
   int labels = 0;
-  for (double t : ticks(bar)) labels = std::max(labels, text_width(format_tick(t, bar.tick_step, bar.plus_sign), scale));
+  for (double t : ticks(bar))
+    labels = std::max(labels, text_width(format_tick(t, bar.tick_step, bar.plus_sign), scale));
   const int line = text_height(scale) + 2 * scale;
   int width = bar_width(scale) + 4 * scale + labels;
   width = std::max({width, text_width(bar.title, scale), text_width(bar.note, scale)});
@@ -58,7 +59,8 @@ void draw_colour_bar(Image& image, int x, int y, const ColourBar& bar, int bar_h
     image.fill_rect(bx + bw, ty, 3 * scale, std::max(1, scale / 2), kInk);
     draw_text(image, bx + bw + 4 * scale, ty - 3 * scale, format_tick(t, bar.tick_step, bar.plus_sign), kInk, scale);
   }
-  if (!bar.note.empty()) draw_text(image, x + kPad, by + bar_height + text_height(scale) / 2 + 2 * scale, bar.note, kInk, scale);
+  if (!bar.note.empty())
+    draw_text(image, x + kPad, by + bar_height + text_height(scale) / 2 + 2 * scale, bar.note, kInk, scale);
 }
 
 }  // namespace sb

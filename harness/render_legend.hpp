@@ -10,13 +10,13 @@
 namespace sb {
 
 struct ColourBar {
-  double lo = 0.0, hi = 1.0;                  // values at the bottom and the top of the bar
+  double lo = 0.0, hi = 1.0;  // values at the bottom and the top of the bar
   std::function<Rgb(double value)> colour;
-  double tick_step = 0.0;                     // ticks at the multiples of this inside [lo, hi]
-  bool plus_sign = false;                     // "+0.002" for positive ticks
-  std::string title;                          // above the bar
-  std::string note;                           // below the bar; may be empty
-  std::vector<double> marks;                  // values drawn as dark lines across the bar
+  double tick_step = 0.0;     // ticks at the multiples of this inside [lo, hi]
+  bool plus_sign = false;     // "+0.002" for positive ticks
+  std::string title;          // above the bar
+  std::string note;           // below the bar; may be empty
+  std::vector<double> marks;  // values drawn as dark lines across the bar
 };
 
 struct BoxSize {

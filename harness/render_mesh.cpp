@@ -1,11 +1,10 @@
 #include "harness/render_mesh.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <stdexcept>
 #include <utility>
-
-#include <Eigen/Geometry>
 
 namespace sb {
 

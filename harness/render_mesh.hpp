@@ -15,9 +15,9 @@
 namespace sb {
 
 struct RenderMesh {
-  Vec3 centre{0.0, 0.0, 0.0};        // subtracted from every position
-  std::vector<float> positions;      // x, y, z per vertex
-  std::vector<float> normals;        // unit, z >= 0
+  Vec3 centre{0.0, 0.0, 0.0};              // subtracted from every position
+  std::vector<float> positions;            // x, y, z per vertex
+  std::vector<float> normals;              // unit, z >= 0
   std::vector<std::uint32_t> triangles;    // 3 per triangle, counter-clockwise seen from above
   std::vector<std::uint32_t> edges;        // 2 per unique edge (empty unless asked for)
   std::vector<std::uint32_t> constrained;  // 2 per constrained edge

@@ -22,7 +22,8 @@ Image render_picture(Renderer& renderer, const SurfaceMesh& mesh, const Raster& 
   bar.tick_step = nice_step(span, 4);
   bar.title = "height (m)";
   bar.note = "contours " + format_tick(frame.contour_step_m, frame.contour_step_m) + " m apart";
-  for (double k = std::floor(frame.z_min_m / frame.contour_step_m); (k + 0.5) * frame.contour_step_m <= frame.z_max_m; ++k)
+  for (double k = std::floor(frame.z_min_m / frame.contour_step_m); (k + 0.5) * frame.contour_step_m <= frame.z_max_m;
+       ++k)
     bar.marks.push_back((k + 0.5) * frame.contour_step_m);
   const int scale = image.height() >= 600 ? 2 : 1;
   const int bar_h = std::max(40, image.height() / 4);

@@ -145,9 +145,12 @@ void write_contents(hid_t file, const RunResult& run, const PreparedScene& p, co
   {
     Handle g = group(file, "summary");
     for (const auto& [key, value] : summary.items()) {
-      if (value.is_number()) double_attribute(g, key, {value.get<double>()});
-      else if (value.is_boolean()) double_attribute(g, key, {value.get<bool>() ? 1.0 : 0.0});
-      else if (value.is_string()) string_attribute(g, key, value.get<std::string>());
+      if (value.is_number())
+        double_attribute(g, key, {value.get<double>()});
+      else if (value.is_boolean())
+        double_attribute(g, key, {value.get<bool>() ? 1.0 : 0.0});
+      else if (value.is_string())
+        string_attribute(g, key, value.get<std::string>());
     }
   }
   {
@@ -164,8 +167,7 @@ void write_contents(hid_t file, const RunResult& run, const PreparedScene& p, co
   dataset(mesh, "vertices", H5T_NATIVE_DOUBLE, xyz.data(), {m.vertices.size(), 3});
   dataset(mesh, "triangles", H5T_NATIVE_UINT32, m.triangles.data()->data(), {m.triangles.size(), 3});
   dataset(mesh, "constrained_edges", H5T_NATIVE_UINT32,
-          m.constrained_edges.empty() ? nullptr : m.constrained_edges.data()->data(),
-          {m.constrained_edges.size(), 2});
+          m.constrained_edges.empty() ? nullptr : m.constrained_edges.data()->data(), {m.constrained_edges.size(), 2});
 }
 
 // Reading.
@@ -234,8 +236,7 @@ herr_t collect_link_name(hid_t, const char* name, const H5L_info_t*, void* out) 
 void write_run_file(const std::filesystem::path& path, const RunResult& run, const PreparedScene& prepared,
                     const Json& summary) {
   write_atomically(path, [&](const std::filesystem::path& tmp) {
-    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose,
-                "create " + tmp.string());
+    Handle file(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose, "create " + tmp.string());
     write_contents(file, run, prepared, summary);
     check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush " + tmp.string());
   });

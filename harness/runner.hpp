@@ -27,14 +27,14 @@ struct PreparedScene {
 PreparedScene prepare_scene(Scene scene);
 
 struct RunResult {
-  std::string backend;  // "tin", "grid"
-  std::string label;    // backend plus variant overrides, e.g. "grid:grid.storage=float"
+  std::string backend;            // "tin", "grid"
+  std::string label;              // backend plus variant overrides, e.g. "grid:grid.storage=float"
   std::vector<StepRecord> steps;  // stroke steps, then relaxation steps (stamp = -1)
   double volume_initial = 0.0;
   double volume_final = 0.0;
   double volume_added = 0.0;
   double max_slope_deg = 0.0;
-  bool settled = false;           // erosion active set empty at the end
+  bool settled = false;  // erosion active set empty at the end
   ModelStats final_stats;
   std::size_t memory_bytes_peak = 0;
   Raster initial_raster;

@@ -14,17 +14,18 @@ namespace sb {
 
 namespace {
 
-using haptics::CsvFile;
-using haptics::CsvTable;
 using haptics::csv_fail;
 using haptics::csv_index;
 using haptics::csv_number;
+using haptics::CsvFile;
+using haptics::CsvTable;
 
 const std::vector<std::string> kForceHeader{"t", "fx", "fy", "fz", "penetration_m"};
-const std::vector<std::string> kToolHeader{"tool",           "shape",           "radius_m",   "size_x_m", "size_y_m",
-                                           "sides",          "profile",         "sphere_radius_m", "depth_m",
-                                           "rim_width_m",    "rim_forward_bias", "pour_volume_m3", "polygon_m"};
-const std::vector<std::string> kStampHeader{"stamp", "t", "x", "y", "bottom_z", "heading_rad", "dir_x", "dir_y", "tool"};
+const std::vector<std::string> kToolHeader{
+    "tool",    "shape",       "radius_m",         "size_x_m",       "size_y_m", "sides", "profile", "sphere_radius_m",
+    "depth_m", "rim_width_m", "rim_forward_bias", "pour_volume_m3", "polygon_m"};
+const std::vector<std::string> kStampHeader{"stamp",       "t",     "x",     "y",   "bottom_z",
+                                            "heading_rad", "dir_x", "dir_y", "tool"};
 
 std::string num(double v) {
   char buf[40];
@@ -55,12 +56,18 @@ ToolSpec read_tool(const CsvFile& f, const CsvTable& t, std::size_t r) {
   ToolSpec tool;
   const std::string& shape = t.rows[r][1];
   const int line = t.lines[r];
-  if (shape == "disk") tool.shape = ToolShape::Disk;
-  else if (shape == "box") tool.shape = ToolShape::Box;
-  else if (shape == "ellipse") tool.shape = ToolShape::Ellipse;
-  else if (shape == "polygon") tool.shape = ToolShape::Polygon;
-  else if (shape == "pour") tool.shape = ToolShape::Pour;
-  else csv_fail(f, line, "column shape = '" + shape + "' must be disk | box | ellipse | polygon | pour");
+  if (shape == "disk")
+    tool.shape = ToolShape::Disk;
+  else if (shape == "box")
+    tool.shape = ToolShape::Box;
+  else if (shape == "ellipse")
+    tool.shape = ToolShape::Ellipse;
+  else if (shape == "polygon")
+    tool.shape = ToolShape::Polygon;
+  else if (shape == "pour")
+    tool.shape = ToolShape::Pour;
+  else
+    csv_fail(f, line, "column shape = '" + shape + "' must be disk | box | ellipse | polygon | pour");
   auto positive = [&](std::size_t col) {
     const double v = csv_number(f, t, r, col);
     if (!(v > 0.0)) csv_fail(f, line, "column " + t.header[col] + " = " + t.rows[r][col] + " must be > 0");
@@ -72,9 +79,12 @@ ToolSpec read_tool(const CsvFile& f, const CsvTable& t, std::size_t r) {
   if (sides < 3 || sides > 4096) csv_fail(f, line, "column sides = " + t.rows[r][5] + " must be in [3, 4096]");
   tool.sides = static_cast<int>(sides);
   const std::string& profile = t.rows[r][6];
-  if (profile == "flat") tool.profile = BottomProfile::Flat;
-  else if (profile == "sphere_cap") tool.profile = BottomProfile::SphereCap;
-  else csv_fail(f, line, "column profile = '" + profile + "' must be flat | sphere_cap");
+  if (profile == "flat")
+    tool.profile = BottomProfile::Flat;
+  else if (profile == "sphere_cap")
+    tool.profile = BottomProfile::SphereCap;
+  else
+    csv_fail(f, line, "column profile = '" + profile + "' must be flat | sphere_cap");
   tool.sphere_radius_m = positive(7);
   tool.depth_m = csv_number(f, t, r, 8);
   tool.rim.width_m = csv_number(f, t, r, 9);
@@ -151,7 +161,8 @@ Session read_session(const std::filesystem::path& file, const std::string& optio
     for (const std::string& c : f.comments) {
       if (c.rfind("set ", 0) == 0) {
         const std::string o = c.substr(4);
-        if (o.find('=') == std::string::npos) throw InputError(f.name + ": comment '# " + c + "' must be '# set key=value'");
+        if (o.find('=') == std::string::npos)
+          throw InputError(f.name + ": comment '# " + c + "' must be '# set key=value'");
         s.overrides.push_back(o);
       } else if (c.rfind("scene: ", 0) == 0) {
         s.scene = c.substr(7);

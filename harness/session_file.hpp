@@ -22,10 +22,10 @@
 namespace sb {
 
 struct SessionStamp {
-  double t_s = 0.0;          // servo time when applied
+  double t_s = 0.0;  // servo time when applied
   ToolPose pose;
   Vec2 motion_dir{0.0, 0.0};
-  std::size_t tool = 0;      // index into Session::tools
+  std::size_t tool = 0;  // index into Session::tools
 };
 
 struct SessionForce {
@@ -35,11 +35,11 @@ struct SessionForce {
 };
 
 struct Session {
-  std::string scene;                    // informational
-  std::string backend;                  // informational
-  std::vector<std::string> overrides;   // "key=value"
+  std::string scene;                   // informational
+  std::string backend;                 // informational
+  std::vector<std::string> overrides;  // "key=value"
   haptics::Trajectory trajectory;
-  std::vector<SessionForce> forces;     // one per trajectory sample, or none
+  std::vector<SessionForce> forces;  // one per trajectory sample, or none
   std::vector<ToolSpec> tools;
   std::vector<SessionStamp> stamps;
 };

@@ -57,9 +57,8 @@ Json summarize(const RunResult& run, const PreparedScene& p) {
   j["volume_initial"] = run.volume_initial;
   j["volume_final"] = run.volume_final;
   j["volume_added"] = run.volume_added;
-  j["volume_drift_rel"] = run.volume_initial != 0.0
-                              ? (run.volume_final - run.volume_initial - run.volume_added) / run.volume_initial
-                              : 0.0;
+  j["volume_drift_rel"] =
+      run.volume_initial != 0.0 ? (run.volume_final - run.volume_initial - run.volume_added) / run.volume_initial : 0.0;
   j["max_slope_excess_deg"] = std::max(0.0, run.max_slope_deg - crit);
   // Extras beyond the contract.
   j["max_slope_deg"] = run.max_slope_deg;

@@ -21,10 +21,13 @@ namespace {
 double tool_radius(const ToolSpec& t) {
   switch (t.shape) {
     case ToolShape::Disk:
-    case ToolShape::Pour: return t.radius_m;
+    case ToolShape::Pour:
+      return t.radius_m;
     case ToolShape::Box:
-    case ToolShape::Ellipse: return t.half_size_m.minCoeff();
-    case ToolShape::Polygon: return std::sqrt(std::abs(signed_area(t.polygon_m)) / std::numbers::pi);
+    case ToolShape::Ellipse:
+      return t.half_size_m.minCoeff();
+    case ToolShape::Polygon:
+      return std::sqrt(std::abs(signed_area(t.polygon_m)) / std::numbers::pi);
   }
   return t.radius_m;
 }

@@ -54,8 +54,7 @@ std::size_t TinTerrain::refine_around(VertexHandle v) {
       if (d <= longest) continue;
       FaceHandle f;
       int i = 0;
-      if (cdt_.is_edge(v, c, f, i) && f->is_constrained(i) && locate(0.5 * (xy(c) + xy(v))).type != Cdt::EDGE)
-        continue;
+      if (cdt_.is_edge(v, c, f, i) && f->is_constrained(i) && locate(0.5 * (xy(c) + xy(v))).type != Cdt::EDGE) continue;
       longest = d;
       far = c;
     } while (++c != done);

@@ -38,8 +38,10 @@ Location TinTerrain::locate(const Vec2& p) const {
       const FaceHandle n = f->neighbor(i);
       if (n == came_from) continue;
       if (orient(f->vertex(Cdt::ccw(i))->point(), f->vertex(Cdt::cw(i))->point(), q) == CGAL::RIGHT_TURN) {
-        if (cdt_.is_infinite(n)) walked_out = true;
-        else next = n;
+        if (cdt_.is_infinite(n))
+          walked_out = true;
+        else
+          next = n;
         break;
       }
     }
@@ -107,8 +109,7 @@ bool TinTerrain::on_border(const Vec2& p) const {
 }
 
 double TinTerrain::height(const Vec2& p) const {
-  if (!std::isfinite(p.x()) || !std::isfinite(p.y()))
-    throw InputError("tin: height query at a non-finite point");
+  if (!std::isfinite(p.x()) || !std::isfinite(p.y())) throw InputError("tin: height query at a non-finite point");
   const Vec2 q = clamp_to_domain(p);
   const Location loc = locate(q);
   hint_ = loc.face->vertex(0);
@@ -122,10 +123,14 @@ VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted
     throw InputError("tin: a vertex must have finite coordinates");
   Vec2 p = clamp_to_domain(p_in);
   const double snap = spec_.snap_m;
-  if (p.x() - box_.lo.x() <= snap) p.x() = box_.lo.x();
-  else if (box_.hi.x() - p.x() <= snap) p.x() = box_.hi.x();
-  if (p.y() - box_.lo.y() <= snap) p.y() = box_.lo.y();
-  else if (box_.hi.y() - p.y() <= snap) p.y() = box_.hi.y();
+  if (p.x() - box_.lo.x() <= snap)
+    p.x() = box_.lo.x();
+  else if (box_.hi.x() - p.x() <= snap)
+    p.x() = box_.hi.x();
+  if (p.y() - box_.lo.y() <= snap)
+    p.y() = box_.lo.y();
+  else if (box_.hi.y() - p.y() <= snap)
+    p.y() = box_.hi.y();
 
   const Location loc = locate(p);
   if (loc.type == Cdt::VERTEX) {
@@ -356,8 +361,7 @@ Capture TinTerrain::begin_capture(const Aabb2& box) {
     }
   }
   c.faces = face_scratch_.size();
-  std::sort(c.outer.begin(), c.outer.end(),
-            [](const OuterFace& x, const OuterFace& y) { return &*x.face < &*y.face; });
+  std::sort(c.outer.begin(), c.outer.end(), [](const OuterFace& x, const OuterFace& y) { return &*x.face < &*y.face; });
   return c;
 }
 
@@ -434,8 +438,9 @@ void TinTerrain::collect_vertices(const Aabb2& box, std::vector<VertexHandle>& o
       const FaceHandle n = f->neighbor(i);
       if (cdt_.is_infinite(n) || n->info() == visited) continue;
       const Point &a = n->vertex(0)->point(), &b = n->vertex(1)->point(), &c = n->vertex(2)->point();
-      const bool overlaps = std::max({a.x(), b.x(), c.x()}) >= box.lo.x() && std::min({a.x(), b.x(), c.x()}) <= box.hi.x() &&
-                            std::max({a.y(), b.y(), c.y()}) >= box.lo.y() && std::min({a.y(), b.y(), c.y()}) <= box.hi.y();
+      const bool overlaps =
+          std::max({a.x(), b.x(), c.x()}) >= box.lo.x() && std::min({a.x(), b.x(), c.x()}) <= box.hi.x() &&
+          std::max({a.y(), b.y(), c.y()}) >= box.lo.y() && std::min({a.y(), b.y(), c.y()}) <= box.hi.y();
       if (!overlaps) continue;
       n->info() = visited;
       queue.push_back(n);

@@ -29,8 +29,7 @@ bool is_flat(const Cdt& cdt, VertexHandle v, double tan_alpha) {
 
 SimplifyReport TinTerrain::simplify(const SimplifyParams& params) {
   if (!std::isfinite(params.alpha_flat_deg) || params.alpha_flat_deg < 0.0 || params.alpha_flat_deg >= 90.0)
-    throw InputError("simplify: alpha_flat_deg = " + std::to_string(params.alpha_flat_deg) +
-                     " must be in [0, 90)");
+    throw InputError("simplify: alpha_flat_deg = " + std::to_string(params.alpha_flat_deg) + " must be in [0, 90)");
   SimplifyReport report;
   const double tan_alpha = std::tan(deg_to_rad(params.alpha_flat_deg));
   const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());

@@ -207,8 +207,7 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
           interior_pts.push_back({p, height(p)});
       }
     }
-    if (box_.contains(s.pose.xy) && s.contains(s.pose.xy))
-      interior_pts.push_back({s.pose.xy, height(s.pose.xy)});
+    if (box_.contains(s.pose.xy) && s.contains(s.pose.xy)) interior_pts.push_back({s.pose.xy, height(s.pose.xy)});
   }
   // Rim vertices where the band has none nearby: a ring in the band's middle to take the
   // deposit, and a ring on its outer edge so the deposit stays in the band (on a coarse TIN
@@ -254,10 +253,9 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
         const FaceHandle n = f->neighbor(i);
         if (cdt_.is_infinite(n) || n->info() == walked) continue;
         const Point &p0 = n->vertex(0)->point(), &p1 = n->vertex(1)->point(), &p2 = n->vertex(2)->point();
-        const bool overlaps = std::max({p0.x(), p1.x(), p2.x()}) >= reach.lo.x() &&
-                              std::min({p0.x(), p1.x(), p2.x()}) <= reach.hi.x() &&
-                              std::max({p0.y(), p1.y(), p2.y()}) >= reach.lo.y() &&
-                              std::min({p0.y(), p1.y(), p2.y()}) <= reach.hi.y();
+        const bool overlaps =
+            std::max({p0.x(), p1.x(), p2.x()}) >= reach.lo.x() && std::min({p0.x(), p1.x(), p2.x()}) <= reach.hi.x() &&
+            std::max({p0.y(), p1.y(), p2.y()}) >= reach.lo.y() && std::min({p0.y(), p1.y(), p2.y()}) <= reach.hi.y();
         if (!overlaps) continue;
         n->info() = walked;
         faces.push_back(n);

@@ -56,8 +56,8 @@ ModelStats TinTerrain::stats() const {
   // element: next pointer plus the (key, value) pair (no cached hash: the hash is noexcept).
   using Node = std::pair<const EdgeKey, std::uint32_t>;
   const std::size_t node = sizeof(void*) + ((sizeof(Node) + alignof(Node) - 1) / alignof(Node)) * alignof(Node);
-  bytes += (generations_.bucket_count() > 1 ? generations_.bucket_count() * sizeof(void*) : 0) +
-           generations_.size() * node;
+  bytes +=
+      (generations_.bucket_count() > 1 ? generations_.bucket_count() * sizeof(void*) : 0) + generations_.size() * node;
   bytes += vector_bytes(erosion_list_) + vector_bytes(simplify_list_) + vector_bytes(nbr_scratch_) +
            vector_bytes(transfer_scratch_) + vector_bytes(vertex_scratch_) + vector_bytes(face_scratch_) +
            vector_bytes(link_scratch_);
@@ -79,8 +79,8 @@ SurfaceMesh TinTerrain::mesh() const {
     m.triangles.push_back({index.at(&*f->vertex(0)), index.at(&*f->vertex(1)), index.at(&*f->vertex(2))});
   for (auto e = cdt_.finite_edges_begin(); e != cdt_.finite_edges_end(); ++e) {
     if (!e->first->is_constrained(e->second)) continue;
-    m.constrained_edges.push_back({index.at(&*e->first->vertex(Cdt::ccw(e->second))),
-                                   index.at(&*e->first->vertex(Cdt::cw(e->second)))});
+    m.constrained_edges.push_back(
+        {index.at(&*e->first->vertex(Cdt::ccw(e->second))), index.at(&*e->first->vertex(Cdt::cw(e->second)))});
   }
   return m;
 }

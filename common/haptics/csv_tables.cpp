@@ -81,8 +81,9 @@ CsvFile parse_csv_tables(const std::string& text, const std::string& name) {
     if (f.tables.empty()) csv_fail(f, line, "data before any header line");
     CsvTable& t = f.tables.back();
     if (cells.size() != t.header.size())
-      csv_fail(f, line, "has " + std::to_string(cells.size()) + " fields; the header " + join(t.header) + " has " +
-                            std::to_string(t.header.size()));
+      csv_fail(f, line,
+               "has " + std::to_string(cells.size()) + " fields; the header " + join(t.header) + " has " +
+                   std::to_string(t.header.size()));
     t.rows.push_back(std::move(cells));
     t.lines.push_back(line);
   }

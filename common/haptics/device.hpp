@@ -13,9 +13,7 @@ namespace sb::haptics {
 struct Aabb3 {
   Vec3 lo{0.0, 0.0, 0.0};
   Vec3 hi{0.0, 0.0, 0.0};
-  bool contains(const Vec3& p) const {
-    return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all();
-  }
+  bool contains(const Vec3& p) const { return (p.array() >= lo.array()).all() && (p.array() <= hi.array()).all(); }
   Vec3 clamp(const Vec3& p) const { return p.cwiseMax(lo).cwiseMin(hi); }
 };
 
@@ -28,17 +26,17 @@ struct DeviceLimits {
 // One reading of the device. The position is the tool's lowest point (the bottom of its
 // footprint) in world coordinates, already clamped to the workspace.
 struct DeviceState {
-  double t_s = 0.0;                 // device time of the pose, seconds
+  double t_s = 0.0;  // device time of the pose, seconds
   Vec3 position_m{0.0, 0.0, 0.0};
-  std::uint32_t buttons = 0;        // bit mask; bit 0 is the primary button
-  bool valid = false;               // false while the device has no pose (no force is sent)
+  std::uint32_t buttons = 0;  // bit mask; bit 0 is the primary button
+  bool valid = false;         // false while the device has no pose (no force is sent)
 };
 
 // One force command: the force in newtons (world axes), already finite and within the
 // device's limits, and what the servo knew when it computed it.
 struct ForceCommand {
   Vec3 force_n{0.0, 0.0, 0.0};
-  double t_s = 0.0;       // servo time
+  double t_s = 0.0;         // servo time
   bool in_contact = false;  // the tool displaces sand
   bool clamped = false;     // the force model asked for more than max_force_n
   bool stale = false;       // no valid pose: the force is zero

@@ -54,13 +54,15 @@ ForceOutput compute_force(const HeightPatch& patch, const Vec3& position_m, cons
     for (int i = 0, j = n - 1; i < n; j = i++) {
       const Vec2& a = poly[static_cast<std::size_t>(j)];
       const Vec2& b = poly[static_cast<std::size_t>(i)];
-      if ((a.y() <= v) != (b.y() <= v)) xs[static_cast<std::size_t>(m++)] = a.x() + (v - a.y()) * (b.x() - a.x()) / (b.y() - a.y());
+      if ((a.y() <= v) != (b.y() <= v))
+        xs[static_cast<std::size_t>(m++)] = a.x() + (v - a.y()) * (b.x() - a.x()) / (b.y() - a.y());
     }
     std::sort(xs.begin(), xs.begin() + m);
     const double dy = h.origin_m.y() + v * h.spacing_m - c.y();
     for (int k = 0; k + 1 < m; k += 2) {
       const int lo = std::max(0, static_cast<int>(std::ceil(xs[static_cast<std::size_t>(k)])));
-      const int hi = std::min(static_cast<int>(h.nx) - 1, static_cast<int>(std::floor(xs[static_cast<std::size_t>(k + 1)])));
+      const int hi =
+          std::min(static_cast<int>(h.nx) - 1, static_cast<int>(std::floor(xs[static_cast<std::size_t>(k + 1)])));
       const double* row = h.values.data() + static_cast<std::size_t>(iy) * h.nx;
       for (int ix = lo; ix <= hi; ++ix) {
         const double dx = h.origin_m.x() + ix * h.spacing_m - c.x();

@@ -21,10 +21,10 @@ struct ForceOutput {
   double penetration_m = 0.0;   // d above
   double displaced_m3 = 0.0;    // sand above the tool bottom inside the footprint
   double contact_fraction = 0.0;
-  double surface_z_m = 0.0;     // patch height under the tool's centre
-  int footprint_points = 0;     // patch points inside the footprint
+  double surface_z_m = 0.0;  // patch height under the tool's centre
+  int footprint_points = 0;  // patch points inside the footprint
   bool in_contact = false;
-  bool outside_patch = false;   // part of the footprint lies beyond the patch (not felt)
+  bool outside_patch = false;  // part of the footprint lies beyond the patch (not felt)
 };
 
 ForceOutput compute_force(const HeightPatch& patch, const Vec3& position_m, const Vec3& velocity_m_s,

@@ -18,16 +18,16 @@ namespace sb::haptics {
 
 // The tool and sand as the force model sees them. Fixed size: copying it never allocates.
 struct ForceParams {
-  static constexpr int kMaxFootprint = 128;       // footprint vertices kept (decimated above)
-  double stiffness_n_per_m = 800.0;               // penetration resistance per metre of depth
-  double drag_n_s_per_m = 5.0;                    // viscous drag while in sand
-  double friction = 0.4;                          // Coulomb coefficient against penetration
-  std::array<Vec2, kMaxFootprint> footprint{};    // tool coordinates, CCW
+  static constexpr int kMaxFootprint = 128;     // footprint vertices kept (decimated above)
+  double stiffness_n_per_m = 800.0;             // penetration resistance per metre of depth
+  double drag_n_s_per_m = 5.0;                  // viscous drag while in sand
+  double friction = 0.4;                        // Coulomb coefficient against penetration
+  std::array<Vec2, kMaxFootprint> footprint{};  // tool coordinates, CCW
   int footprint_size = 0;
   BottomProfile profile = BottomProfile::Flat;
   double sphere_radius_m = 0.0;
-  double heading_rad = 0.0;                       // footprint rotation about z
-  double reach_m = 0.0;                           // largest footprint distance from the origin
+  double heading_rad = 0.0;  // footprint rotation about z
+  double reach_m = 0.0;      // largest footprint distance from the origin
 
   // From the material's haptic parameters and a tool (a pour tool feels like a disk of its
   // pour radius). O(footprint).
@@ -35,10 +35,10 @@ struct ForceParams {
 };
 
 struct HeightPatch {
-  bool valid = false;           // false until the simulation's first publication
-  std::uint64_t version = 0;    // increases with every publication
-  Vec2 centre_m{0.0, 0.0};      // tool position the patch was centred on
-  Raster heights;               // nx = ny = PatchLayout::cells, around centre_m
+  bool valid = false;         // false until the simulation's first publication
+  std::uint64_t version = 0;  // increases with every publication
+  Vec2 centre_m{0.0, 0.0};    // tool position the patch was centred on
+  Raster heights;             // nx = ny = PatchLayout::cells, around centre_m
   ForceParams params;
 };
 
@@ -48,7 +48,7 @@ using PatchBuffer = TripleBuffer<HeightPatch>;
 // covering the tool's reach plus a margin the tool may travel before the next publication.
 struct PatchLayout {
   std::size_t cells = 49;
-  double half_m = 0.04;     // half the side
+  double half_m = 0.04;  // half the side
   double spacing_m = 0.04 / 24;
   static PatchLayout for_tool(double reach_m, double margin_m, std::size_t cells = 49);
 };

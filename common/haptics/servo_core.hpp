@@ -20,7 +20,7 @@ struct ServoState {
   Vec3 force_n{0.0, 0.0, 0.0};  // as commanded
   ForceOutput model;            // the model's view (its force before limiting)
   bool clamped = false;
-  bool nonfinite = false;       // the model's force was not finite; zero was sent
+  bool nonfinite = false;  // the model's force was not finite; zero was sent
   std::uint64_t patch_version = 0;
   // Running counters of the loop (filled by ServoLoop).
   std::uint64_t missed_deadlines = 0;

@@ -46,7 +46,7 @@ void ServoLoop::run() {
   const auto spin = std::chrono::duration_cast<nanoseconds>(duration<double, std::micro>(options_.spin_us));
   const auto t0 = ServoClock::now();
   core_.start();
-  auto deadline = t0;                   // scheduled start of the next tick
+  auto deadline = t0;  // scheduled start of the next tick
   auto first_start = t0, last_start = t0;
   auto rate_window_start = t0;
   std::uint64_t rate_window_ticks = 0;
@@ -109,9 +109,8 @@ void ServoLoop::run() {
     }
   }
   stats_.duration_s = duration<double>(last_start - first_start).count();
-  stats_.servo_hz = stats_.ticks > 1 && stats_.duration_s > 0.0
-                        ? static_cast<double>(stats_.ticks - 1) / stats_.duration_s
-                        : 0.0;
+  stats_.servo_hz =
+      stats_.ticks > 1 && stats_.duration_s > 0.0 ? static_cast<double>(stats_.ticks - 1) / stats_.duration_s : 0.0;
 }
 
 }  // namespace sb::haptics

@@ -19,8 +19,8 @@ namespace sb::haptics {
 
 struct ServoOptions {
   double rate_hz = 1000.0;
-  double spin_us = 150.0;            // spin this long before each deadline
-  bool realtime = true;              // ask for SCHED_FIFO (silently not, when refused)
+  double spin_us = 150.0;  // spin this long before each deadline
+  bool realtime = true;    // ask for SCHED_FIFO (silently not, when refused)
   double velocity_cutoff_hz = 40.0;
   std::size_t record_capacity = 1u << 17;  // samples queued for the recorder (131 s at 1 kHz)
 };
@@ -39,13 +39,13 @@ struct ServoSample {
 // and a few more.
 struct ServoStats {
   std::uint64_t ticks = 0;
-  double duration_s = 0.0;       // first to last tick start
-  double servo_hz = 0.0;         // (ticks - 1) / duration_s
+  double duration_s = 0.0;                                         // first to last tick start
+  double servo_hz = 0.0;                                           // (ticks - 1) / duration_s
   double tick_us_p50 = 0.0, tick_us_p99 = 0.0, tick_us_max = 0.0;  // work per tick
   double late_us_p50 = 0.0, late_us_p99 = 0.0, late_us_max = 0.0;  // wake-up after deadline
   std::uint64_t missed_deadlines = 0;
-  double force_max_n = 0.0;      // largest force commanded
-  double force_limit_n = 0.0;    // the device's limit
+  double force_max_n = 0.0;    // largest force commanded
+  double force_limit_n = 0.0;  // the device's limit
   std::uint64_t forces_clamped = 0, forces_nonfinite = 0;
   std::uint64_t ticks_in_contact = 0, ticks_without_pose = 0, ticks_outside_patch = 0;
   std::uint64_t samples_dropped = 0;  // recording queue full

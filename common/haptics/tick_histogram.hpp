@@ -18,7 +18,10 @@ class TickHistogram {
     ++count_;
     if (us > max_) max_ = us;
     const auto bin = static_cast<std::size_t>(us / kBinUs);
-    if (bin < bins_.size()) ++bins_[bin]; else ++overflow_;
+    if (bin < bins_.size())
+      ++bins_[bin];
+    else
+      ++overflow_;
   }
   std::uint64_t count() const { return count_; }
   double max() const { return max_; }

@@ -39,9 +39,9 @@ class TripleBuffer {
  private:
   static constexpr unsigned kIndex = 3, kFresh = 4;
   std::array<T, 3> slots_{};
-  unsigned back_ = 0;                 // writer's slot
-  unsigned front_ = 1;                // reader's slot
-  std::atomic<unsigned> middle_{2};   // the hand-over slot, plus kFresh when not yet taken
+  unsigned back_ = 0;                // writer's slot
+  unsigned front_ = 1;               // reader's slot
+  std::atomic<unsigned> middle_{2};  // the hand-over slot, plus kFresh when not yet taken
 };
 
 }  // namespace sb::haptics

@@ -43,8 +43,8 @@ DeviceState UdpDevice::read(double now_s) {
   // Drain: keep the newest valid pose (loopback delivers in order).
   for (int i = 0; i < 4096; ++i) {
     socklen_t len = sizeof from;
-    const ssize_t n = ::recvfrom(fd_, buf.data(), buf.size(), MSG_DONTWAIT | MSG_TRUNC,
-                                 reinterpret_cast<sockaddr*>(&from), &len);
+    const ssize_t n =
+        ::recvfrom(fd_, buf.data(), buf.size(), MSG_DONTWAIT | MSG_TRUNC, reinterpret_cast<sockaddr*>(&from), &len);
     if (n < 0) break;  // EAGAIN: nothing more (other errors: try again next tick)
     const auto pose = static_cast<std::size_t>(n) == buf.size() ? udp::decode_pose(buf) : std::nullopt;
     if (!pose) {
@@ -71,8 +71,8 @@ void UdpDevice::command_force(const ForceCommand& c) {
   f.seq = last_.seq;
   f.t_s = c.t_s;
   f.force_n = c.force_n;
-  f.flags = (c.in_contact ? udp::kFlagContact : 0u) | (c.clamped ? udp::kFlagClamped : 0u) |
-            (c.stale ? udp::kFlagStale : 0u);
+  f.flags =
+      (c.in_contact ? udp::kFlagContact : 0u) | (c.clamped ? udp::kFlagClamped : 0u) | (c.stale ? udp::kFlagStale : 0u);
   f.max_force_n = static_cast<float>(limits_.max_force_n);
   const udp::Packet p = udp::encode(f);
   if (::sendto(fd_, p.data(), p.size(), MSG_DONTWAIT, reinterpret_cast<const sockaddr*>(peer_), sizeof(sockaddr_in)) ==

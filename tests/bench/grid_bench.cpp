@@ -23,7 +23,8 @@ constexpr double kSand = 0.1;
 template <class Real>
 GridTerrain<Real> flat_grid() {
   const GridLayout layout = GridLayout::covering({{0.0, 0.0}, {kSize, kSize}}, kCell);
-  return GridTerrain<Real>(layout, [](const sb::Vec2&) { return kSand; }, 8, 2);
+  return GridTerrain<Real>(
+      layout, [](const sb::Vec2&) { return kSand; }, 8, 2);
 }
 
 sb::ToolSpec disk(double radius_m, double depth_m) {
@@ -67,8 +68,7 @@ GridTerrain<Real> prepared(Start start) {
     t.stamp(sb::make_stamp(pour, pose, sb::Vec2::Zero(), 0));
   } else {
     const sb::ToolSpec spec = disk(0.05, 0.03);
-    for (int i = 0; i <= 40; ++i)
-      t.stamp(stamp_at(spec, centre + sb::Vec2(-0.2 + 0.01 * i, 0.0), {1.0, 0.0}));
+    for (int i = 0; i <= 40; ++i) t.stamp(stamp_at(spec, centre + sb::Vec2(-0.2 + 0.01 * i, 0.0), {1.0, 0.0}));
   }
   return t;
 }
@@ -95,10 +95,26 @@ void BM_Erosion(benchmark::State& state) {
   state.counters["updates_per_call"] = benchmark::Counter(updates, benchmark::Counter::kAvgIterations);
   state.counters["active_at_start"] = static_cast<double>(start.stats().active);
 }
-BENCHMARK(BM_Erosion<float, Start::Pile>)->Name("BM_ErosionPile<float>")->ArgName("passes")->Arg(64)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Erosion<double, Start::Pile>)->Name("BM_ErosionPile<double>")->ArgName("passes")->Arg(64)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Erosion<float, Start::Stroke>)->Name("BM_ErosionStroke<float>")->ArgName("passes")->Arg(64)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Erosion<double, Start::Stroke>)->Name("BM_ErosionStroke<double>")->ArgName("passes")->Arg(64)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Erosion<float, Start::Pile>)
+    ->Name("BM_ErosionPile<float>")
+    ->ArgName("passes")
+    ->Arg(64)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Erosion<double, Start::Pile>)
+    ->Name("BM_ErosionPile<double>")
+    ->ArgName("passes")
+    ->Arg(64)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Erosion<float, Start::Stroke>)
+    ->Name("BM_ErosionStroke<float>")
+    ->ArgName("passes")
+    ->Arg(64)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Erosion<double, Start::Stroke>)
+    ->Name("BM_ErosionStroke<double>")
+    ->ArgName("passes")
+    ->Arg(64)
+    ->Unit(benchmark::kMillisecond);
 
 // One stamp of a disk of the given radius (in cells) on fresh sand: stamps walk a lattice
 // of positions far enough apart that none overlaps the last; the grid is reset (untimed)

@@ -41,7 +41,8 @@ radius_m = 0.02
 path_m = [[0.35, 0.35]]
 [grid]
 cell_m = 0.0022360679
-)", "haptics_bench.toml");
+)",
+                                     "haptics_bench.toml");
   return s;
 }
 
@@ -115,8 +116,8 @@ void BM_ForceModel(benchmark::State& state) {
   double x = 0.0;
   for (auto _ : state) {
     x += 1e-4;
-    const ForceOutput f = compute_force(patch, Vec3(centre.x() + 0.005 * std::sin(x), centre.y(), z),
-                                        Vec3(0.05, 0.0, 0.0), 2000.0);
+    const ForceOutput f =
+        compute_force(patch, Vec3(centre.x() + 0.005 * std::sin(x), centre.y(), z), Vec3(0.05, 0.0, 0.0), 2000.0);
     benchmark::DoNotOptimize(limit_force(f.force_n, 8.0));
   }
   counters(state, backend);

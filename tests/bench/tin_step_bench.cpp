@@ -34,7 +34,8 @@ constexpr int kPoses = 12;
 
 // A reproducible value in [0, 1) from two integers (splitmix64).
 double hash01(std::int64_t i, std::int64_t j, std::uint64_t salt) {
-  std::uint64_t x = static_cast<std::uint64_t>(i) * 0x9E3779B97F4A7C15ull ^ static_cast<std::uint64_t>(j) * 0xC2B2AE3D27D4EB4Full ^ salt;
+  std::uint64_t x = static_cast<std::uint64_t>(i) * 0x9E3779B97F4A7C15ull ^
+                    static_cast<std::uint64_t>(j) * 0xC2B2AE3D27D4EB4Full ^ salt;
   x ^= x >> 30;
   x *= 0xBF58476D1CE4E5B9ull;
   x ^= x >> 27;

@@ -88,8 +88,10 @@ nlohmann::ordered_json make_golden(const Case& c, const nlohmann::ordered_json& 
     const double v = s[p.metric].get<double>();
     nlohmann::ordered_json m;
     m["value"] = v;
-    if (p.at_most) m["at_most"] = std::abs(v) * (1.0 + p.rel) + p.abs;
-    else m["tolerance"] = std::abs(v) * p.rel + p.abs;
+    if (p.at_most)
+      m["at_most"] = std::abs(v) * (1.0 + p.rel) + p.abs;
+    else
+      m["tolerance"] = std::abs(v) * p.rel + p.abs;
     g["metrics"][p.metric] = m;
   }
   return g;
@@ -123,12 +125,12 @@ TEST_P(Regression, MetricsWithinGoldenBounds) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Canonical, Regression, ::testing::ValuesIn(cases()),
-                         [](const auto& info) {
-                           std::string n = info.param.name;
-                           for (char& ch : n) if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
-                           return n;
-                         });
+INSTANTIATE_TEST_SUITE_P(Canonical, Regression, ::testing::ValuesIn(cases()), [](const auto& info) {
+  std::string n = info.param.name;
+  for (char& ch : n)
+    if (!std::isalnum(static_cast<unsigned char>(ch))) ch = '_';
+  return n;
+});
 
 }  // namespace
 }  // namespace sb

@@ -59,7 +59,8 @@ struct Runner {
   std::uint32_t generation = 0;
 
   explicit Runner(const Scene& s)
-      : scene(s), terrain(make_tin_terrain(s, HeightField::from_scene(s))),
+      : scene(s),
+        terrain(make_tin_terrain(s, HeightField::from_scene(s))),
         rule(ErosionRule::from(s.material, s.erosion.settle_tolerance_deg)) {}
 
   // One step with check() after each phase; returns false (after reporting) on a problem.
@@ -111,8 +112,10 @@ TEST(TinStress, CrossingStrokes) {
       }
       // Without compensation, Delaunay flips after splits and insertions change the volume
       // by a few percent of the sand moved.
-      if (conserve) EXPECT_NEAR(run.terrain->volume(), v0, 1e-12 * v0);
-      else EXPECT_NEAR(run.terrain->volume(), v0, 0.05 * v0);
+      if (conserve)
+        EXPECT_NEAR(run.terrain->volume(), v0, 1e-12 * v0);
+      else
+        EXPECT_NEAR(run.terrain->volume(), v0, 0.05 * v0);
       std::printf("crossing %s conserve %d: drift %.3g of the initial volume, %zu vertices\n",
                   text == kScene ? "flat" : "dunes", conserve, (run.terrain->volume() - v0) / v0,
                   run.terrain->stats().vertices);
@@ -152,7 +155,8 @@ size_m = [0.04, 0.02]
 depth_m = 0.01
 [stroke]
 path_m = [[0.05, 0.05]]
-)", "stress"));
+)",
+                         "stress"));
   for (int pass = 0; pass < 3; ++pass)
     for (int k = 0; k < 40; ++k) {
       const double x = 0.06 + 0.005 * k, y = 0.15 + 0.01 * (pass - 1);
@@ -167,16 +171,34 @@ TEST(TinStress, RandomStrokes) {
   for (std::uint64_t seed : {1u, 2u, 3u}) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> u(0.0, 1.0);
-    Runner run(parse_scene(seed == 2 ? kDunes : kScene, "stress", {seed == 3 ? "tin.conserve_volume=true" : "tin.snap_m=1e-6"}));
+    Runner run(parse_scene(seed == 2 ? kDunes : kScene, "stress",
+                           {seed == 3 ? "tin.conserve_volume=true" : "tin.snap_m=1e-6"}));
     const double v0 = run.terrain->volume();
     for (int stroke = 0; stroke < 10; ++stroke) {
       ToolSpec tool = run.scene.tool;
       switch (static_cast<int>(u(rng) * 5)) {
-        case 0: tool.shape = ToolShape::Disk; tool.radius_m = 0.005 + 0.03 * u(rng); tool.sides = 3 + static_cast<int>(u(rng) * 60); break;
-        case 1: tool.shape = ToolShape::Box; tool.half_size_m = {0.003 + 0.02 * u(rng), 0.003 + 0.02 * u(rng)}; break;
-        case 2: tool.shape = ToolShape::Ellipse; tool.half_size_m = {0.005 + 0.02 * u(rng), 0.002 + 0.01 * u(rng)}; break;
-        case 3: tool.shape = ToolShape::Polygon; tool.polygon_m = {{-0.02, -0.01}, {0.02, -0.015}, {0.005, 0.0}, {0.02, 0.015}, {-0.02, 0.01}}; break;
-        default: tool.shape = ToolShape::Pour; tool.radius_m = 0.002 + 0.01 * u(rng); tool.pour_volume_m3 = 1e-7 + 1e-6 * u(rng); break;
+        case 0:
+          tool.shape = ToolShape::Disk;
+          tool.radius_m = 0.005 + 0.03 * u(rng);
+          tool.sides = 3 + static_cast<int>(u(rng) * 60);
+          break;
+        case 1:
+          tool.shape = ToolShape::Box;
+          tool.half_size_m = {0.003 + 0.02 * u(rng), 0.003 + 0.02 * u(rng)};
+          break;
+        case 2:
+          tool.shape = ToolShape::Ellipse;
+          tool.half_size_m = {0.005 + 0.02 * u(rng), 0.002 + 0.01 * u(rng)};
+          break;
+        case 3:
+          tool.shape = ToolShape::Polygon;
+          tool.polygon_m = {{-0.02, -0.01}, {0.02, -0.015}, {0.005, 0.0}, {0.02, 0.015}, {-0.02, 0.01}};
+          break;
+        default:
+          tool.shape = ToolShape::Pour;
+          tool.radius_m = 0.002 + 0.01 * u(rng);
+          tool.pour_volume_m3 = 1e-7 + 1e-6 * u(rng);
+          break;
       }
       if (u(rng) < 0.3) {
         tool.profile = BottomProfile::SphereCap;
@@ -196,8 +218,10 @@ TEST(TinStress, RandomStrokes) {
         ASSERT_TRUE(run.step(schedule.stamps[k])) << "seed " << seed << " stroke " << stroke;
     }
     const double drift = run.terrain->volume() - v0 - run.volume_added;
-    if (seed == 3) EXPECT_NEAR(drift, 0.0, 1e-11 * v0);
-    else EXPECT_NEAR(drift, 0.0, 0.05 * v0);
+    if (seed == 3)
+      EXPECT_NEAR(drift, 0.0, 1e-11 * v0);
+    else
+      EXPECT_NEAR(drift, 0.0, 0.05 * v0);
     std::printf("random seed %llu: drift %.3g of the initial volume, %zu vertices, %u stamps\n",
                 static_cast<unsigned long long>(seed), drift / v0, run.terrain->stats().vertices, run.generation);
   }

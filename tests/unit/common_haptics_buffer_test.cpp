@@ -112,7 +112,7 @@ TEST(HapticsTickHistogram, PercentilesAreUpperBinEdgesAndMaxIsExact) {
   EXPECT_DOUBLE_EQ(h.max(), 1e6);
   EXPECT_DOUBLE_EQ(h.percentile(1.0), 1e6);
   EXPECT_NEAR(h.percentile(0.5), 51.0, TickHistogram::kBinUs + 1e-9);  // rank 51 of 101
-  h.add(-3.0);  // a clock going backwards counts as zero
+  h.add(-3.0);                                                         // a clock going backwards counts as zero
   EXPECT_EQ(h.count(), 102u);
 }
 
@@ -136,7 +136,8 @@ wavelength_m = 0.15
 path_m = [[0.25, 0.25]]
 [grid]
 cell_m = 0.005
-)", "patch.toml");
+)",
+                                  "patch.toml");
   const HeightField initial = HeightField::from_scene(scene);
   const auto terrain = grid::make_grid_terrain(scene, initial);
   const ForceParams params = ForceParams::from(test::sand(), test::disk(0.02));

@@ -35,10 +35,10 @@ std::string input_error(const std::string& text) {
 }
 
 TEST(HapticsTrajectory, ParsesTheReplayFormatWithCommentsAndLaterTables) {
-  const Trajectory t = trajectory_from(parse_csv_tables(
-      "# a comment\n\nt,x,y,z,buttons\n0,0.1,0.2,0.3,0\n0.5, 0.2 ,0.2,0.25,1\n1.0,0.3,0.2,0.2,3\n"
-      "stamp,t,x\n0,1,2\n",
-      "traj.csv"));
+  const Trajectory t = trajectory_from(
+      parse_csv_tables("# a comment\n\nt,x,y,z,buttons\n0,0.1,0.2,0.3,0\n0.5, 0.2 ,0.2,0.25,1\n1.0,0.3,0.2,0.2,3\n"
+                       "stamp,t,x\n0,1,2\n",
+                       "traj.csv"));
   ASSERT_EQ(t.samples.size(), 3u);
   EXPECT_EQ(t.samples[1].position_m, Vec3(0.2, 0.2, 0.25));
   EXPECT_EQ(t.samples[2].buttons, 3u);

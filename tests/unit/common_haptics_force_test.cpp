@@ -157,9 +157,10 @@ TEST(HapticsForce, RandomSandAndPosesGiveFiniteForces) {
   for (int trial = 0; trial < 200; ++trial) {
     const double a = 0.05 * u(rng), k = 20.0 + 200.0 * u(rng);
     ToolSpec tool = disk(0.005 + 0.04 * u(rng), trial % 2 ? BottomProfile::SphereCap : BottomProfile::Flat);
-    const ForceParams params = ForceParams::from(sand(5000.0 * u(rng), 50.0 * u(rng), 2.0 * u(rng)), tool, 6.0 * u(rng));
-    const HeightPatch p =
-        test::patch([&](const Vec2& q) { return 0.1 + a * std::sin(k * q.x()) * std::cos(k * q.y()); }, kCentre, params);
+    const ForceParams params =
+        ForceParams::from(sand(5000.0 * u(rng), 50.0 * u(rng), 2.0 * u(rng)), tool, 6.0 * u(rng));
+    const HeightPatch p = test::patch(
+        [&](const Vec2& q) { return 0.1 + a * std::sin(k * q.x()) * std::cos(k * q.y()); }, kCentre, params);
     const Vec3 pos(kCentre.x() + 0.1 * (u(rng) - 0.5), kCentre.y() + 0.1 * (u(rng) - 0.5), 0.05 + 0.1 * u(rng));
     const Vec3 vel = Vec3(u(rng) - 0.5, u(rng) - 0.5, u(rng) - 0.5) * 10.0;
     const ForceOutput f = compute_force(p, pos, vel, 3000.0);

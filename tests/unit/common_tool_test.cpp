@@ -13,8 +13,7 @@ double rasterised_area(const ToolStamp& s, double h) {
   const Aabb2 b = bounds(s.footprint);
   std::size_t inside = 0;
   for (double y = std::floor(b.lo.y() / h) * h + h / 2; y < b.hi.y(); y += h)
-    for (double x = std::floor(b.lo.x() / h) * h + h / 2; x < b.hi.x(); x += h)
-      inside += s.contains({x, y});
+    for (double x = std::floor(b.lo.x() / h) * h + h / 2; x < b.hi.x(); x += h) inside += s.contains({x, y});
   return static_cast<double>(inside) * h * h;
 }
 
@@ -52,7 +51,7 @@ TEST(Footprint, PoseRotatesAndTranslates) {
   t.shape = ToolShape::Box;
   t.half_size_m = {0.02, 0.01};
   const ToolStamp s = make_stamp(t, {{1.0, 2.0}, 0.0, std::numbers::pi / 2}, {0.0, 1.0}, 0);
-  EXPECT_TRUE(s.contains({1.0, 2.015}));   // long axis now along y
+  EXPECT_TRUE(s.contains({1.0, 2.015}));  // long axis now along y
   EXPECT_FALSE(s.contains({1.015, 2.0}));
 }
 

@@ -26,8 +26,8 @@ TYPED_TEST(GridErosion, FullRelaxationEndsAtTheCriticalAngle) {
   for (const int neighbours : {8, 4}) {
     for (const double angle : {30.0, 34.0}) {
       SCOPED_TRACE(std::to_string(neighbours) + " neighbours, " + std::to_string(angle) + " degrees");
-      const Scene s = scene({"grid.neighbours=" + std::to_string(neighbours),
-                             "material.critical_angle_deg=" + std::to_string(angle)});
+      const Scene s = scene(
+          {"grid.neighbours=" + std::to_string(neighbours), "material.critical_angle_deg=" + std::to_string(angle)});
       const auto t = make_grid<TypeParam>(s);
       t->stamp(column());
       const double v0 = t->volume();

@@ -83,16 +83,18 @@ bool same_bits(Real a, Real b) {
   return std::memcmp(&a, &b, sizeof(Real)) == 0;
 }
 
-#define SB_EXPECT_CHECK_OK(terrain)                                          \
-  do {                                                                       \
-    const ::sb::IntegrityReport integrity_ = (terrain).check();              \
+#define SB_EXPECT_CHECK_OK(terrain)                                                \
+  do {                                                                             \
+    const ::sb::IntegrityReport integrity_ = (terrain).check();                    \
     EXPECT_TRUE(integrity_.ok()) << ::testing::PrintToString(integrity_.problems); \
   } while (0)
 
 using StorageTypes = ::testing::Types<float, double>;
 struct StorageName {
   template <class T>
-  static std::string GetName(int) { return sizeof(T) == 8 ? "double" : "float"; }
+  static std::string GetName(int) {
+    return sizeof(T) == 8 ? "double" : "float";
+  }
 };
 
 }  // namespace sb::grid::test

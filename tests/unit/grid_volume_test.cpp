@@ -58,8 +58,9 @@ Drift drift_after_1000_stamps(const std::vector<std::string>& overrides = {}) {
   }
   d.relative = (t->volume() - v0) / v0;
   d.carry_relative = t->heights().carry_m3() / v0;
-  std::printf("grid<%s>: volume drift after 1000 stamps %.3e relative, rounding carry %.3e (cut %.3e m^3, eroded %.3e m^3)\n",
-              sizeof(Real) == 8 ? "double" : "float", d.relative, d.carry_relative, d.cut_m3, d.moved_m3);
+  std::printf(
+      "grid<%s>: volume drift after 1000 stamps %.3e relative, rounding carry %.3e (cut %.3e m^3, eroded %.3e m^3)\n",
+      sizeof(Real) == 8 ? "double" : "float", d.relative, d.carry_relative, d.cut_m3, d.moved_m3);
   return d;
 }
 

@@ -31,7 +31,7 @@ class Cli : public ::testing::Test {
 TEST_F(Cli, BadSceneValueExitsTwoNamesTheFieldAndWritesNothing) {
   const fs::path out = dir_ / "run.h5";
   const auto r = sandbench("run " + scene("flat_stroke.toml") + " --backend grid --out " + out.string() +
-                             " --set tool.radius_m=-3");
+                           " --set tool.radius_m=-3");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("tool.radius_m"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("out of range"), std::string::npos) << r.out;
@@ -62,10 +62,13 @@ TEST_F(Cli, RunPrintsEveryContractMetricAndWritesTheRunFile) {
   ASSERT_EQ(r.code, 0) << r.out;
   const auto json_start = r.out.find('{');
   const auto json = nlohmann::json::parse(r.out.substr(json_start, r.out.rfind('}') - json_start + 1));
-  for (const char* key : {"time_s.tool", "time_s.erosion", "time_s.simplify", "time_s.total", "step_ms.p50",
-                          "step_ms.p95", "step_ms.max", "memory_bytes", "memory_bytes_peak", "vertices", "triangles",
-                          "constrained_edges", "cells", "volume_initial", "volume_final", "volume_added",
-                          "volume_drift_rel", "max_slope_excess_deg", "stamps", "backend", "scene"})
+  for (const char* key : {"time_s.tool",  "time_s.erosion",   "time_s.simplify",
+                          "time_s.total", "step_ms.p50",      "step_ms.p95",
+                          "step_ms.max",  "memory_bytes",     "memory_bytes_peak",
+                          "vertices",     "triangles",        "constrained_edges",
+                          "cells",        "volume_initial",   "volume_final",
+                          "volume_added", "volume_drift_rel", "max_slope_excess_deg",
+                          "stamps",       "backend",          "scene"})
     EXPECT_TRUE(json.contains(key)) << key;
   EXPECT_EQ(json["backend"], "grid");
   EXPECT_EQ(json["stamps"], 21);

@@ -2,8 +2,6 @@
 // PNG16 heightmap reloads as a scene heightmap within one quantisation step; `sandbench
 // export` refuses bad input with exit code 2 and leaves nothing behind.
 #include <gtest/gtest.h>
-
-#include "harness_test_support.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,6 +21,7 @@
 #include "common/scene.hpp"
 #include "harness/export.hpp"
 #include "harness/render_mesh.hpp"
+#include "harness_test_support.hpp"
 
 namespace sb {
 namespace {
@@ -242,8 +241,8 @@ using test::sandbench;  // the binary as a process (harness_test_support.hpp)
 
 TEST_F(Export, CommandWritesEachFormatAndRefusesBadInput) {
   const fs::path run = dir_ / "grid.h5";
-  auto r = sandbench("run " + std::string(SB_SOURCE_DIR) + "/experiments/scenes/flat_stroke.toml --backend grid --out " +
-                       run.string());
+  auto r = sandbench("run " + std::string(SB_SOURCE_DIR) +
+                     "/experiments/scenes/flat_stroke.toml --backend grid --out " + run.string());
   ASSERT_EQ(r.code, 0) << r.out;
   for (const char* format : {"ply", "obj", "png16"}) {
     const fs::path out = dir_ / (std::string("out.") + format);

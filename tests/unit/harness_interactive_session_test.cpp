@@ -1,8 +1,8 @@
 // Sessions: the record/replay file, the simulation thread driven by a replay device without
 // a window, and a recorded session replayed by `sandbench run --replay` on both back-ends.
 #include <gtest/gtest.h>
-
-#include "harness_test_support.hpp"
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -10,9 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
-#include <sys/wait.h>
 #include <thread>
-#include <unistd.h>
 
 #include "common/haptics/replay_device.hpp"
 #include "common/input_error.hpp"
@@ -20,6 +18,7 @@
 #include "harness/interactive_device.hpp"
 #include "harness/interactive_sim.hpp"
 #include "harness/session_file.hpp"
+#include "harness_test_support.hpp"
 
 namespace sb {
 namespace {
@@ -231,7 +230,7 @@ TEST_F(Session_, RunReplaysASessionOnBothBackEnds) {
   write_session(file, s);
   for (const std::string backend : {"grid", "tin"}) {
     const auto r = sandbench("run " + scene_path() + " --backend " + backend + " --replay " + file.string() +
-                               " --json --out " + (dir_ / (backend + ".h5")).string());
+                             " --json --out " + (dir_ / (backend + ".h5")).string());
     ASSERT_EQ(r.code, 0) << r.out;
     const auto j = last_json(r.out);
     EXPECT_EQ(j["stamps"], 3) << backend;

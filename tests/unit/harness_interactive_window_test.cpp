@@ -126,9 +126,8 @@ TEST_F(Window, ReplayDeviceOnBothBackEndsRecordsASessionThatRunReplays) {
     const fs::path shot = dir_ / (backend + ".png"), stats = dir_ / (backend + ".json"),
                    session = dir_ / (backend + "-session.csv");
     const Result r = shell(xvfb() + SB_CLI_PATH + " interactive " + scene_path() + " --backend " + backend +
-                           " --device replay:" + stroke.string() + " --frames 150 --size 800 500" +
-                           " --screenshot " + shot.string() + " --stats " + stats.string() + " --record " +
-                           session.string());
+                           " --device replay:" + stroke.string() + " --frames 150 --size 800 500" + " --screenshot " +
+                           shot.string() + " --stats " + stats.string() + " --record " + session.string());
     ASSERT_EQ(r.code, 0) << r.out;
     std::cout << "[" << backend << "] " << r.out;
     expect_not_blank(shot);
@@ -142,9 +141,9 @@ TEST_F(Window, ReplayDeviceOnBothBackEndsRecordsASessionThatRunReplays) {
     const Session recorded = read_session(session, "--replay");
     EXPECT_EQ(recorded.stamps.size(), s["sim.stamps"].get<std::size_t>());
     for (const std::string replay_on : {"grid", "tin"}) {
-      const Result run = shell(std::string(SB_CLI_PATH) + " run " + scene_path() + " --backend " + replay_on +
-                               " --replay " + session.string() + " --json --out " +
-                               (dir_ / (backend + "-on-" + replay_on + ".h5")).string());
+      const Result run =
+          shell(std::string(SB_CLI_PATH) + " run " + scene_path() + " --backend " + replay_on + " --replay " +
+                session.string() + " --json --out " + (dir_ / (backend + "-on-" + replay_on + ".h5")).string());
       ASSERT_EQ(run.code, 0) << run.out;
       const auto a = run.out.find('{'), b = run.out.rfind('}');
       const auto j = nlohmann::json::parse(run.out.substr(a, b - a + 1));
@@ -171,8 +170,9 @@ TEST_F(Window, UdpBridgeDrivenByThePythonDevice) {
   const std::string py = "/usr/bin/python3 " + std::string(SB_SOURCE_DIR) + "/experiments/udp_device.py --port " +
                          std::to_string(port) + " --scene " + scene_path() +
                          " --duration 2.5 --wait 1.0 --extra-depth 0.002 --out " + client.string();
-  const std::string app = xvfb() + SB_CLI_PATH + " interactive " + scene_path() + " --backend grid --device udp:" +
-                          std::to_string(port) + " --frames 300 --size 640 400 --stats " + stats.string();
+  const std::string app = xvfb() + SB_CLI_PATH + " interactive " + scene_path() +
+                          " --backend grid --device udp:" + std::to_string(port) +
+                          " --frames 300 --size 640 400 --stats " + stats.string();
   const Result r = shell("(" + py + ") & pid=$!; " + app + "; rc=$?; wait $pid || exit 9; exit $rc");
   ASSERT_EQ(r.code, 0) << r.out;
   std::cout << "[udp] " << r.out;

@@ -2,8 +2,6 @@
 // `sandbench render` as a process: pictures are not blank, shading agrees with the
 // heights, output is deterministic, bad input exits 2 and leaves nothing behind.
 #include <gtest/gtest.h>
-
-#include "harness_test_support.hpp"
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,6 +21,7 @@
 #include "harness/render_font.hpp"
 #include "harness/render_frame.hpp"
 #include "harness/render_mesh.hpp"
+#include "harness_test_support.hpp"
 
 namespace sb {
 namespace {
@@ -163,8 +162,8 @@ TEST_F(Render, WireframeDrawsConstrainedEdgesInRed) {
   SurfaceMesh mesh = mesh_;
   const std::size_t row = raster_.ny / 2;
   for (std::size_t ix = 0; ix + 1 < raster_.nx; ++ix)
-    mesh.constrained_edges.push_back({static_cast<std::uint32_t>(row * raster_.nx + ix),
-                                      static_cast<std::uint32_t>(row * raster_.nx + ix + 1)});
+    mesh.constrained_edges.push_back(
+        {static_cast<std::uint32_t>(row * raster_.nx + ix), static_cast<std::uint32_t>(row * raster_.nx + ix + 1)});
   RenderOptions o;
   o.view = View::Top;
   o.width = o.height = 200;
@@ -257,8 +256,11 @@ TEST(RenderLabels, TextAndNumbersAreDrawnAndFormatted) {
 
 TEST(ComparePictures, DifferenceMapIsRedWhereTheSecondIsHigher) {
   const Raster initial = raster_of([](const Vec2&) { return 0.1; });
-  const Raster base = raster_of([](const Vec2& p) { return 0.1 - 0.01 * std::exp(-(p - Vec2(0.1, 0.1)).squaredNorm() / 2e-4); });
-  const Raster higher = raster_of([&](const Vec2& p) { return base.interpolate(p) + 0.002 * std::exp(-(p - Vec2(0.1, 0.1)).squaredNorm() / 1e-4); });
+  const Raster base =
+      raster_of([](const Vec2& p) { return 0.1 - 0.01 * std::exp(-(p - Vec2(0.1, 0.1)).squaredNorm() / 2e-4); });
+  const Raster higher = raster_of([&](const Vec2& p) {
+    return base.interpolate(p) + 0.002 * std::exp(-(p - Vec2(0.1, 0.1)).squaredNorm() / 1e-4);
+  });
   SurfaceMesh m0 = mesh_from_raster(base), m1 = mesh_from_raster(higher);
   const Json s0 = {{"vertices", 0}, {"cells", 10000}, {"memory_bytes", 80000}};
   const Json s1 = {{"vertices", 321}, {"triangles", 600}, {"constrained_edges", 40}, {"memory_bytes", 20000}};
@@ -304,8 +306,8 @@ class RenderCli : public ::testing::Test {
                                         ::testing::UnitTest::GetInstance()->current_test_info()->name());
     fs::create_directories(dir_);
     run_ = dir_ / "grid.h5";
-    const auto r = sandbench("run " + std::string(SB_SOURCE_DIR) + "/experiments/scenes/flat_stroke.toml --backend grid --out " +
-                               run_.string());
+    const auto r = sandbench("run " + std::string(SB_SOURCE_DIR) +
+                             "/experiments/scenes/flat_stroke.toml --backend grid --out " + run_.string());
     ASSERT_EQ(r.code, 0) << r.out;
   }
   void TearDown() override { fs::remove_all(dir_); }

@@ -130,7 +130,9 @@ class TerrainTyped : public ::testing::Test {
 
 struct BackendName {
   template <class T>
-  static std::string GetName(int) { return T::kName; }
+  static std::string GetName(int) {
+    return T::kName;
+  }
 };
 using Backends = ::testing::Types<Tin, Grid>;
 TYPED_TEST_SUITE(TerrainTyped, Backends, BackendName);

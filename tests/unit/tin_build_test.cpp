@@ -73,7 +73,8 @@ TEST(TinBuild, HeightmapSceneIsBuiltWithinTolerance) {
 size_m = [0.4, 0.4]
 [terrain]
 kind = "heightmap"
-path = ")") + path.string() + R"("
+path = ")") + path.string() +
+                           R"("
 vertical_scale_m = 0.05
 [tool]
 radius_m = 0.02
@@ -118,7 +119,8 @@ std::size_t non_delaunay_triangles(const SurfaceMesh& m, double rel_tolerance) {
     const Vec2 ab = b - a, ac = c - a;
     const double d = 2.0 * cross2(ab, ac);
     const Vec2 centre = a + Vec2(ac.y() * ab.squaredNorm() - ab.y() * ac.squaredNorm(),
-                                 ab.x() * ac.squaredNorm() - ac.x() * ab.squaredNorm()) / d;
+                                 ab.x() * ac.squaredNorm() - ac.x() * ab.squaredNorm()) /
+                                d;
     const double r2 = (centre - a).squaredNorm();
     for (std::size_t k = 0; k < m.vertices.size(); ++k) {
       if (k == tri[0] || k == tri[1] || k == tri[2]) continue;
@@ -167,8 +169,8 @@ TEST(TinBuild, DelaunayAwayFromConstraintsAfterStamps) {
     const Vec2 c = m.vertices[apices[0]].head<2>(), d = m.vertices[apices[1]].head<2>();
     // d inside the circle through a, b, c (orientation-independent form).
     const Vec2 ad = a - d, bd = b - d, cd = c - d;
-    const double det = ad.squaredNorm() * cross2(bd, cd) - bd.squaredNorm() * cross2(ad, cd) +
-                       cd.squaredNorm() * cross2(ad, bd);
+    const double det =
+        ad.squaredNorm() * cross2(bd, cd) - bd.squaredNorm() * cross2(ad, cd) + cd.squaredNorm() * cross2(ad, bd);
     const double orient = cross2(b - a, c - a);
     const double scale = ad.squaredNorm() * bd.norm() * cd.norm() + 1e-300;
     if (det * (orient > 0 ? 1.0 : -1.0) > 1e-9 * scale) ++illegal;

@@ -116,8 +116,8 @@ TEST(TinErosion, APileOnTwoTrianglesRefinesAndRelaxesToACone) {
 }
 
 TEST(TinErosion, ConserveVolumeMakesRefiningErosionExact) {
-  const Scene s = scene(kPileScene, {"stroke.repeat=2", "tool.volume_m3=5e-6", "tin.refine_m=0.004",
-                                     "tin.conserve_volume=true"});
+  const Scene s =
+      scene(kPileScene, {"stroke.repeat=2", "tool.volume_m3=5e-6", "tin.refine_m=0.004", "tin.conserve_volume=true"});
   auto t = make(s);
   const double v0 = t->volume();
   double added = 0.0;

@@ -73,7 +73,8 @@ Counted counted(Make&& make) {
 void expect_bytes_match(const Counted& c, double tolerance, const char* what) {
   const double reported = static_cast<double>(c.terrain->stats().bytes);
   const double actual = static_cast<double>(c.bytes);
-  EXPECT_NEAR(reported, actual, tolerance * actual) << what << ": stats().bytes " << reported << ", allocator " << actual;
+  EXPECT_NEAR(reported, actual, tolerance * actual)
+      << what << ": stats().bytes " << reported << ", allocator " << actual;
 }
 
 // stats().bytes counts the containers' capacities; the allocator sees the same blocks. The

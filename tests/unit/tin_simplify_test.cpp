@@ -27,7 +27,8 @@ std::unique_ptr<Terrain> two_plane_tin(const Scene& s) {
     const Vec2 p(((i % side) + u(rng)) * cell, ((i / side) + u(rng)) * cell);
     pts.emplace_back(p.x(), p.y(), two_planes(p));
   }
-  for (const Vec2& c : {Vec2(0, 0), Vec2(0.5, 0), Vec2(0, 0.5), Vec2(0.5, 0.5)}) pts.emplace_back(c.x(), c.y(), two_planes(c));
+  for (const Vec2& c : {Vec2(0, 0), Vec2(0.5, 0), Vec2(0, 0.5), Vec2(0.5, 0.5)})
+    pts.emplace_back(c.x(), c.y(), two_planes(c));
   return make_tin_terrain_from_points(s, pts);
 }
 

@@ -50,14 +50,14 @@ using Traits = CGAL::Projection_traits_xy_3<Kernel>;
 using VertexBase = CGAL::Triangulation_vertex_base_with_info_2<VertexInfo, Traits>;
 // The face's mark goes last, into the padding after the constraint flags: 56 bytes a face
 // (the other order pads to 64).
-using FaceBase = CGAL::Triangulation_face_base_with_info_2<FaceMark, Traits,
-                                                           CGAL::Constrained_triangulation_face_base_2<Traits>>;
+using FaceBase =
+    CGAL::Triangulation_face_base_with_info_2<FaceMark, Traits, CGAL::Constrained_triangulation_face_base_2<Traits>>;
 using Tds = CGAL::Triangulation_data_structure_2<VertexBase, FaceBase>;
 // Constraints may pass through existing vertices but never cross each other: the stamp drops
 // every old constraint near a new one first, so no intersection point is ever constructed
 // (the input that trips CGAL issues 2999, 3263 and 5439 cannot arise).
-using Cdt = CGAL::Constrained_Delaunay_triangulation_2<
-    Traits, Tds, CGAL::No_constraint_intersection_requiring_constructions_tag>;
+using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Traits, Tds,
+                                                       CGAL::No_constraint_intersection_requiring_constructions_tag>;
 using Point = Kernel::Point_3;
 using VertexHandle = Cdt::Vertex_handle;
 using FaceHandle = Cdt::Face_handle;
@@ -98,8 +98,8 @@ struct OuterFace {
   int toward = 0;           // index of the neighbour inside the region
 };
 struct Capture {
-  std::vector<OuterFace> outer;   // finite faces just outside the region, sorted by address
-  double volume = 0.0;            // integral of z over the region before
+  std::vector<OuterFace> outer;  // finite faces just outside the region, sorted by address
+  double volume = 0.0;           // integral of z over the region before
   double area = 0.0;
   std::size_t faces = 0;
 };
@@ -113,15 +113,15 @@ struct CaptureResult {
 class TinTerrain final : public Terrain {
  public:
   explicit TinTerrain(const Scene& scene);
-  void build_from_field(const HeightField& field);                // build.cpp
-  void build_from_points(const std::vector<Vec3>& points);        // build.cpp
+  void build_from_field(const HeightField& field);          // build.cpp
+  void build_from_points(const std::vector<Vec3>& points);  // build.cpp
 
   std::string_view name() const override { return "tin"; }
-  double height(const Vec2& p) const override;                             // mesh_ops.cpp
-  StampReport stamp(const ToolStamp& s) override;                          // stamp.cpp
+  double height(const Vec2& p) const override;                                         // mesh_ops.cpp
+  StampReport stamp(const ToolStamp& s) override;                                      // stamp.cpp
   ErosionReport erode(const ErosionRule& rule, const ErosionBudget& budget) override;  // erosion.cpp
-  SimplifyReport simplify(const SimplifyParams& params) override;          // simplify.cpp
-  double volume() const override;                                          // stats_check.cpp
+  SimplifyReport simplify(const SimplifyParams& params) override;                      // simplify.cpp
+  double volume() const override;                                                      // stats_check.cpp
   ModelStats stats() const override;
   SurfaceMesh mesh() const override;
   void sample(Raster& out) const override;
@@ -158,8 +158,8 @@ class TinTerrain final : public Terrain {
   CaptureResult end_capture(Capture& c, std::vector<VertexHandle>* region_vertices = nullptr);
   // Vertices inside `box` (a traversal of the faces overlapping it).
   void collect_vertices(const Aabb2& box, std::vector<VertexHandle>& out);
-  void touch(VertexHandle v);                   // joins L_e (idle count reset)
-  void touch_with_neighbours(VertexHandle v);   // v and its neighbours join L_e
+  void touch(VertexHandle v);                  // joins L_e (idle count reset)
+  void touch_with_neighbours(VertexHandle v);  // v and its neighbours join L_e
   void drop_from_erosion(VertexHandle v);
   void add_to_simplify(VertexHandle v);
   void drop_from_simplify(VertexHandle v);
@@ -191,8 +191,8 @@ class TinTerrain final : public Terrain {
 
   Cdt cdt_;
   std::unordered_map<EdgeKey, std::uint32_t, EdgeKeyHash> generations_;  // constrained edges
-  std::vector<VertexHandle> erosion_list_;   // L_e
-  std::vector<VertexHandle> simplify_list_;  // L_r
+  std::vector<VertexHandle> erosion_list_;                               // L_e
+  std::vector<VertexHandle> simplify_list_;                              // L_r
 
   mutable VertexHandle hint_;
   mutable std::uint64_t walk_steps_ = 0;
