@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake ninja-build pkg-config git
+  build-essential cmake pkg-config git
   libeigen3-dev libcgal-dev libgmp-dev libmpfr-dev libboost-dev
   libhdf5-dev libpng-dev libosmesa6-dev
   libgtest-dev libgmock-dev libbenchmark-dev
@@ -31,6 +31,14 @@ fi
 echo "deps: installing ${missing[*]}" >&2
 sudo_cmd=()
 if [[ $(id -u) -ne 0 ]]; then
+  # Neither root nor a usable sudo: say what to install rather than fail on a missing command
+  # (sudo that asks for a password works only from a terminal).
+  if ! command -v sudo >/dev/null 2>&1 || { ! [[ -t 0 ]] && ! sudo -n true 2>/dev/null; }; then
+    echo "deps: missing Debian packages: ${missing[*]}" >&2
+    echo "deps: installing them needs root or sudo, and neither is available here; as root run:" >&2
+    echo "  apt-get install --no-install-recommends ${missing[*]}" >&2
+    exit 2
+  fi
   sudo_cmd=(sudo)
 fi
 export DEBIAN_FRONTEND=noninteractive
