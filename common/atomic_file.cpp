@@ -1,21 +1,106 @@
 #include "common/atomic_file.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <string>
+
+#include "common/input_error.hpp"
 
 namespace sb {
 
-void write_atomically(const std::filesystem::path& target,
-                      const std::function<void(const std::filesystem::path&)>& write) {
-  std::filesystem::path temporary = target;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Removes TARGET.tmpPID files whose process is gone (a kill -9 leaves them behind).
+void remove_stale_temporaries(const fs::path& target) {
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const std::string prefix = target.filename().string() + ".tmp";
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(digits));
+    if (pid == ::getpid()) continue;
+    if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge
+    std::error_code ignored;
+    if (fs::is_regular_file(fs::symlink_status(it->path(), ignored))) fs::remove(it->path(), ignored);
+  }
+}
+
+bool same_file(const fs::path& a, const fs::path& b) {
+  std::error_code ec;
+  if (fs::equivalent(a, b, ec)) return true;
+  return fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec) && !ec;
+}
+
+void check_common(const fs::path& target, const std::string& option, const std::vector<fs::path>& inputs) {
+  if (target.empty()) throw InputError(option + ": the path is empty; give a file name");
+  for (const fs::path& in : inputs)
+    if (!in.empty() && same_file(target, in))
+      throw InputError(option + " " + target.string() + ": is the input " + in.string() +
+                       "; writing there would destroy it, choose another path");
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw InputError(option + " " + target.string() + ": directory " + dir.string() + " does not exist");
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    throw InputError(option + " " + target.string() + ": directory " + dir.string() + " is not writable");
+}
+
+std::string kind_of(fs::file_type t) {
+  switch (t) {
+    case fs::file_type::directory:
+      return "a directory";
+    case fs::file_type::symlink:
+      return "a symbolic link (give the path it points to)";
+    case fs::file_type::block:
+    case fs::file_type::character:
+      return "a device";
+    case fs::file_type::fifo:
+      return "a FIFO";
+    case fs::file_type::socket:
+      return "a socket";
+    default:
+      return "not a regular file";
+  }
+}
+
+}  // namespace
+
+void check_output_path(const fs::path& target, const std::string& option, const std::vector<fs::path>& inputs) {
+  check_common(target, option, inputs);
+  std::error_code ec;
+  const fs::file_status st = fs::symlink_status(target, ec);
+  if (fs::exists(st) && st.type() != fs::file_type::regular)
+    throw InputError(option + " " + target.string() + ": is " + kind_of(st.type()) +
+                     "; the output must be a regular file, new or to be replaced");
+}
+
+void check_output_directory(const fs::path& target, const std::string& option, const std::vector<fs::path>& inputs) {
+  // "out/" names the directory "out".
+  check_common(target.has_filename() ? target : target.parent_path(), option, inputs);
+  std::error_code ec;
+  const fs::file_status st = fs::symlink_status(target, ec);
+  if (fs::exists(st) && st.type() != fs::file_type::directory)
+    throw InputError(option + " " + target.string() + ": is " + kind_of(st.type()) +
+                     "; the output must be a directory, new or existing");
+}
+
+void write_atomically(const fs::path& target, const std::function<void(const fs::path&)>& write) {
+  remove_stale_temporaries(target);
+  fs::path temporary = target;
   temporary += ".tmp" + std::to_string(::getpid());
   try {
     write(temporary);
-    std::filesystem::rename(temporary, target);
+    fs::rename(temporary, target);
   } catch (...) {
     std::error_code ignored;
-    std::filesystem::remove(temporary, ignored);
+    fs::remove(temporary, ignored);
     throw;
   }
 }

@@ -53,33 +53,55 @@ void write_png(const std::filesystem::path& file, std::size_t width, std::size_t
 }
 }  // namespace
 
+namespace {
+// Deflate cannot compress better than about 1032:1, so a PNG whose declared pixels need more
+// than that many times its file size is truncated or hostile: refuse it before allocating.
+constexpr double kMaxDeflateRatio = 1032.0;
+}  // namespace
+
 Png16 read_png16(const std::filesystem::path& file, const std::string& field) {
+  const std::string what = "scene: " + field + " = \"" + file.string() + "\"";
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) {
+    if (std::filesystem::exists(file, ec)) throw InputError(what + " is not a regular file");
+    throw InputError(what + " cannot be opened");
+  }
+  const auto file_bytes = static_cast<double>(std::filesystem::file_size(file, ec));
   File f(std::fopen(file.c_str(), "rb"));
-  if (!f) throw InputError("scene: " + field + " = \"" + file.string() + "\" cannot be opened");
+  if (!f) throw InputError(what + " cannot be opened");
   png_byte sig[8];
-  if (std::fread(sig, 1, 8, f.get()) != 8 || png_sig_cmp(sig, 0, 8) != 0)
-    throw InputError("scene: " + field + " = \"" + file.string() + "\" is not a PNG file");
+  if (std::fread(sig, 1, 8, f.get()) != 8 || png_sig_cmp(sig, 0, 8) != 0) throw InputError(what + " is not a PNG file");
   png_structp png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, png_error_handler, png_warning_handler);
   png_infop info = png_create_info_struct(png);
   Png16 out;
   try {
     png_init_io(png, f.get());
     png_set_sig_bytes(png, 8);
+    png_set_user_limits(png, kMaxPngSide, kMaxPngSide);
     png_read_info(png, info);
     const int depth = png_get_bit_depth(png, info);
     const int type = png_get_color_type(png, info);
     if (depth != 16 || (type != PNG_COLOR_TYPE_GRAY && type != PNG_COLOR_TYPE_GRAY_ALPHA))
-      throw InputError("scene: " + field + " = \"" + file.string() + "\" must be a 16-bit greyscale PNG (got " +
-                       std::to_string(depth) + "-bit, colour type " + std::to_string(type) + ")");
+      throw InputError(what + " must be a 16-bit greyscale PNG (got " + std::to_string(depth) + "-bit, colour type " +
+                       std::to_string(type) + ")");
     out.width = png_get_image_width(png, info);
     out.height = png_get_image_height(png, info);
-    if (out.width < 2 || out.height < 2)
-      throw InputError("scene: " + field + " = \"" + file.string() + "\" must be at least 2x2 pixels");
+    if (out.width < 2 || out.height < 2) throw InputError(what + " must be at least 2x2 pixels");
     const std::size_t channels = type == PNG_COLOR_TYPE_GRAY ? 1 : 2;
-    std::vector<png_byte> row(out.width * channels * 2);
+    const std::size_t row_bytes = out.width * channels * 2;
+    if (static_cast<double>(row_bytes) * static_cast<double>(out.height) > kMaxDeflateRatio * file_bytes)
+      throw InputError(what + " declares " + std::to_string(out.width) + "x" + std::to_string(out.height) +
+                       " pixels, more than its " + std::to_string(static_cast<long long>(file_bytes)) +
+                       " bytes can hold: the file is truncated or corrupt");
+    // Adam7-interlaced files are stored in seven passes; libpng reassembles them when asked.
+    const int passes = png_set_interlace_handling(png);
+    png_read_update_info(png, info);
+    std::vector<png_byte> pixels(row_bytes * out.height);
+    for (int pass = 0; pass < passes; ++pass)
+      for (std::size_t r = 0; r < out.height; ++r) png_read_row(png, pixels.data() + r * row_bytes, nullptr);
     out.values.resize(out.width * out.height);
     for (std::size_t r = 0; r < out.height; ++r) {
-      png_read_row(png, row.data(), nullptr);
+      const png_byte* row = pixels.data() + r * row_bytes;
       for (std::size_t c = 0; c < out.width; ++c)
         out.values[r * out.width + c] =
             static_cast<std::uint16_t>((row[c * channels * 2] << 8) | row[c * channels * 2 + 1]);
@@ -89,7 +111,7 @@ Png16 read_png16(const std::filesystem::path& file, const std::string& field) {
     throw;
   } catch (const std::exception& e) {
     png_destroy_read_struct(&png, &info, nullptr);
-    throw InputError("scene: " + field + " = \"" + file.string() + "\" is not a readable PNG: " + e.what());
+    throw InputError(what + " is not a readable PNG: " + e.what());
   }
   png_destroy_read_struct(&png, &info, nullptr);
   return out;

@@ -215,7 +215,27 @@ class Fields {
   std::set<std::string> seen_;
 };
 
+// "unset KEY" (what --unset KEY adds) removes a key, so that a default applies again or a
+// key that belongs to another tool shape goes away.
+void apply_unset(toml::table& root, const std::string& key) {
+  toml::table* t = &root;
+  std::size_t start = 0;
+  for (std::size_t dot; (dot = key.find('.', start)) != std::string::npos; start = dot + 1) {
+    toml::node* child = t->get(key.substr(start, dot - start));
+    t = child ? child->as_table() : nullptr;
+    if (!t) return;  // nothing to remove
+  }
+  t->erase(key.substr(start));
+}
+
 void apply_override(toml::table& root, const std::string& assignment) {
+  if (assignment.rfind(kUnsetPrefix, 0) == 0) {
+    const std::string key = assignment.substr(std::string(kUnsetPrefix).size());
+    if (key.empty() || key.find_first_of(" =") != std::string::npos)
+      throw InputError("--unset " + key + ": expected a key, e.g. tool.radius_m");
+    apply_unset(root, key);
+    return;
+  }
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0)
     throw InputError("--set " + assignment + ": expected key=value, e.g. tool.radius_m=0.02");
@@ -323,6 +343,20 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   const double length = polyline_length(s.stroke.path_m);
   if (length / s.stroke.spacing_m * s.stroke.repeat > 1e7)
     Fields::fail("stroke.spacing_m", "gives more than 1e7 stamps for this path; use a larger spacing");
+  // Every stamp costs at least its footprint's vertices on every back-end: refuse runs that
+  // would take hours before they start rather than after.
+  const double stamps = static_cast<double>(stamp_arc_count(length, s.stroke.spacing_m)) * s.stroke.repeat;
+  const double corners = t.shape == ToolShape::Polygon ? static_cast<double>(t.polygon_m.size())
+                         : t.shape == ToolShape::Box   ? 4.0
+                         : t.shape == ToolShape::Pour  ? 1.0
+                                                       : static_cast<double>(t.sides);
+  if (stamps * corners > kMaxStampCorners) {
+    std::ostringstream msg;
+    msg << "gives " << stamps << " stamps of a " << corners << "-corner footprint (" << stamps * corners
+        << " corners, more than " << kMaxStampCorners
+        << "); use a larger stroke.spacing_m, a smaller stroke.repeat or fewer tool.sides";
+    Fields::fail("stroke.spacing_m", msg.str());
+  }
 
   // [tin]
   s.tin.alpha_flat_deg = f.number("tin.alpha_flat_deg", 0.4, closed(0.0, 45.0));

@@ -94,6 +94,15 @@ struct Scene {
   ReferenceKind reference = ReferenceKind::None;
 };
 
+// Largest stamp count x footprint corners a scene may ask for: beyond it a run takes hours.
+inline constexpr double kMaxStampCorners = 2e9;
+
+// An override "unset KEY" (what `--unset KEY` adds to the overrides) removes KEY, e.g. so
+// that `--unset tool.radius_m --set tool.shape=box --set tool.size_m=[0.04,0.02]` switches a
+// disk scene to a box. Overrides apply in order.
+inline constexpr const char* kUnsetPrefix = "unset ";
+inline std::string unset_override(const std::string& key) { return kUnsetPrefix + key; }
+
 // Loads and validates a scene; throws InputError naming the offending key.
 Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});
 // Same, from text (base_dir resolves relative heightmap paths).

@@ -31,6 +31,7 @@ void run_command(const RunOptions& o) {
   }
   PreparedScene prepared = prepare_scene(load_scene(o.scene, overrides));
   if (!o.replay.empty()) {
+    validate_session(session, prepared.scene, "--replay " + o.replay);
     prepared.schedule = session_schedule(session);
     prepared.scene.reference = ReferenceKind::None;  // the analytic references follow the scene's stroke
   }

@@ -1,13 +1,16 @@
 #include "harness/runner.hpp"
 
 #include <algorithm>
+#include <memory>
 
 namespace sb {
 
 PreparedScene prepare_scene(Scene scene) {
   PreparedScene p{std::move(scene), {}, {}, {}, {}};
   p.initial = HeightField::from_scene(p.scene);
-  p.schedule = make_schedule(p.scene.tool, p.scene.stroke, [&](const Vec2& q) { return p.initial(q); });
+  // The lazy schedule outlives this function and copies of `p`: it keeps its own surface.
+  auto surface = std::make_shared<const HeightField>(p.initial);
+  p.schedule = make_schedule(p.scene.tool, p.scene.stroke, [surface](const Vec2& q) { return (*surface)(q); });
   p.rule = ErosionRule::from(p.scene.material, p.scene.erosion.settle_tolerance_deg);
   p.raster_template = Raster::covering(p.scene.domain.box(), p.scene.output.raster_m);
   return p;

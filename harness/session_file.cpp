@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 #include "common/atomic_file.hpp"
@@ -150,6 +151,12 @@ void write_session(const std::filesystem::path& file, const Session& s) {
 }
 
 Session read_session(const std::filesystem::path& file, const std::string& option) {
+  // The CSV reader holds the whole file as text and cells: bound it before reading.
+  std::error_code ec;
+  const auto bytes = std::filesystem::file_size(file, ec);
+  if (!ec && bytes > kMaxSessionBytes)
+    throw InputError(option + " " + file.string() + ": " + std::to_string(bytes) +
+                     " bytes, more than a session may have (" + std::to_string(kMaxSessionBytes) + ")");
   CsvFile f;
   try {
     f = haptics::read_csv_tables(file.string());
@@ -186,6 +193,9 @@ Session read_session(const std::filesystem::path& file, const std::string& optio
       if (csv_index(f, *tools, r, 0) != r) csv_fail(f, tools->lines[r], "column tool must count 0, 1, 2, ...");
       s.tools.push_back(read_tool(f, *tools, r));
     }
+    if (stamps->rows.size() > kMaxSessionStamps)
+      throw InputError(f.name + ": " + std::to_string(stamps->rows.size()) + " stamps, more than a scene may have (" +
+                       std::to_string(kMaxSessionStamps) + ")");
     for (std::size_t r = 0; r < stamps->rows.size(); ++r) {
       SessionStamp st;
       st.t_s = csv_number(f, *stamps, r, 1);
@@ -194,6 +204,14 @@ Session read_session(const std::filesystem::path& file, const std::string& optio
       st.pose.heading_rad = csv_number(f, *stamps, r, 5);
       st.motion_dir = {csv_number(f, *stamps, r, 6), csv_number(f, *stamps, r, 7)};
       st.tool = csv_index(f, *stamps, r, 8);
+      // The ranges a scene's stroke has (stroke.path_m within domain.origin_m's range,
+      // stroke.z_m), so a replay cannot ask for what a scene may not.
+      for (std::size_t col : {2, 3, 4})
+        if (!(std::fabs(csv_number(f, *stamps, r, col)) < kMaxCoordinate))
+          csv_fail(f, stamps->lines[r],
+                   "column " + stamps->header[col] + " = " + stamps->rows[r][col] + " is out of range (-1e9, 1e9)");
+      if (st.motion_dir.norm() > 1.0 + 1e-9)
+        csv_fail(f, stamps->lines[r], "columns dir_x, dir_y must be a unit vector or zero");
       if (st.tool >= s.tools.size())
         csv_fail(f, stamps->lines[r], "column tool = " + stamps->rows[r][8] + " names no row of the tool table");
       s.stamps.push_back(st);
@@ -204,13 +222,90 @@ Session read_session(const std::filesystem::path& file, const std::string& optio
   }
 }
 
-StampSchedule session_schedule(const Session& session) {
-  StampSchedule schedule;
-  std::uint32_t generation = 0;
-  for (const SessionStamp& st : session.stamps) {
-    if (!schedule.stamps.empty()) schedule.length_m += (st.pose.xy - schedule.stamps.back().pose.xy).norm();
-    schedule.stamps.push_back(make_stamp(session.tools[st.tool], st.pose, st.motion_dir, generation++));
+namespace {
+// A session tool as scene overrides: the keys the scene format has for its shape.
+std::vector<std::string> tool_overrides(const ToolSpec& t) {
+  std::vector<std::string> o{unset_override("tool"), "tool.shape=\"" + to_string(t.shape) + "\""};
+  const std::string size = "tool.size_m=[" + num(2.0 * t.half_size_m.x()) + "," + num(2.0 * t.half_size_m.y()) + "]";
+  switch (t.shape) {
+    case ToolShape::Disk:
+      o.push_back("tool.radius_m=" + num(t.radius_m));
+      o.push_back("tool.sides=" + std::to_string(t.sides));
+      break;
+    case ToolShape::Pour:
+      o.push_back("tool.radius_m=" + num(t.radius_m));
+      o.push_back("tool.volume_m3=" + num(t.pour_volume_m3));
+      return o;
+    case ToolShape::Box:
+      o.push_back(size);
+      break;
+    case ToolShape::Ellipse:
+      o.push_back(size);
+      o.push_back("tool.sides=" + std::to_string(t.sides));
+      break;
+    case ToolShape::Polygon: {
+      std::string poly;
+      for (const Vec2& p : t.polygon_m) poly += (poly.empty() ? "" : ",") + ("[" + num(p.x()) + "," + num(p.y()) + "]");
+      o.push_back("tool.polygon_m=[" + poly + "]");
+      break;
+    }
   }
+  o.push_back("tool.depth_m=" + num(t.depth_m));
+  o.push_back("tool.profile=\"" + to_string(t.profile) + "\"");
+  if (t.profile == BottomProfile::SphereCap) o.push_back("tool.sphere_radius_m=" + num(t.sphere_radius_m));
+  o.push_back("tool.rim_width_m=" + num(t.rim.width_m));
+  o.push_back("tool.rim_forward_bias=" + num(t.rim.forward_bias));
+  return o;
+}
+
+double footprint_corners(const ToolSpec& t) {
+  switch (t.shape) {
+    case ToolShape::Box:
+      return 4.0;
+    case ToolShape::Polygon:
+      return static_cast<double>(t.polygon_m.size());
+    case ToolShape::Pour:
+      return 1.0;
+    default:
+      return static_cast<double>(t.sides);
+  }
+}
+}  // namespace
+
+void validate_session(const Session& session, const Scene& scene, const std::string& option) {
+  for (std::size_t i = 0; i < session.tools.size(); ++i) {
+    std::vector<std::string> overrides = scene.overrides;
+    const std::vector<std::string> tool = tool_overrides(session.tools[i]);
+    overrides.insert(overrides.end(), tool.begin(), tool.end());
+    try {
+      parse_scene(scene.text, scene.path, overrides, std::filesystem::path(scene.path).parent_path());
+    } catch (const InputError& e) {
+      throw InputError(option + ": tool " + std::to_string(i) +
+                       " of the session is not a valid tool for this scene: " + e.what());
+    }
+  }
+  double corners = 0.0;
+  for (const SessionStamp& st : session.stamps) corners += footprint_corners(session.tools[st.tool]);
+  if (corners > kMaxStampCorners)
+    throw InputError(option + ": the session's " + std::to_string(session.stamps.size()) + " stamps have " +
+                     num(corners) + " footprint corners in all, more than a scene may ask for (" +
+                     num(kMaxStampCorners) + ")");
+}
+
+StampSchedule session_schedule(const Session& session) {
+  // The poses are shared with the generator; footprints are built one stamp at a time.
+  struct Poses {
+    std::vector<SessionStamp> stamps;
+    std::vector<ToolSpec> tools;
+  };
+  auto poses = std::make_shared<const Poses>(Poses{session.stamps, session.tools});
+  StampSchedule schedule;
+  for (std::size_t i = 1; i < session.stamps.size(); ++i)
+    schedule.length_m += (session.stamps[i].pose.xy - session.stamps[i - 1].pose.xy).norm();
+  schedule.stamps = StampSequence(session.stamps.size(), [poses](std::size_t i) {
+    const SessionStamp& st = poses->stamps[i];
+    return make_stamp(poses->tools[st.tool], st.pose, st.motion_dir, static_cast<std::uint32_t>(i));
+  });
   return schedule;
 }
 

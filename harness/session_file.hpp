@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "common/haptics/trajectory.hpp"
+#include "common/scene.hpp"
 #include "common/schedule.hpp"
 #include "common/tool.hpp"
 
@@ -49,7 +50,19 @@ void write_session(const std::filesystem::path& file, const Session& session);
 // "--replay") prefixes the message.
 Session read_session(const std::filesystem::path& file, const std::string& option);
 
-// The stamps of a session as a schedule (generations renumbered from 0). O(stamps).
+// Bounds on what a session file may hold (a scene's stroke may have at most 1e7 stamps).
+inline constexpr std::size_t kMaxSessionStamps = 10000000;
+inline constexpr std::uintmax_t kMaxSessionBytes = std::uintmax_t{256} << 20;  // about 2.5e6 stamp rows
+inline constexpr double kMaxCoordinate = 1e9;
+
+// Checks a session against the scene it is replayed on with the scene's own validation:
+// every tool must pass as that scene's [tool] (ranges relative to the domain), and the stamp
+// count times footprint corners must stay within kMaxStampCorners. Throws InputError
+// prefixed by `option`. O(tools x scene parse + stamps).
+void validate_session(const Session& session, const Scene& scene, const std::string& option);
+
+// The stamps of a session as a lazy schedule (generations renumbered from 0): keeps a copy of
+// the poses, O(stamps) small records; footprints are built when a stamp is asked for.
 StampSchedule session_schedule(const Session& session);
 
 // Adds `tool` to the session's tool table unless an identical one is there; its index.

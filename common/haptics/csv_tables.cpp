@@ -103,7 +103,10 @@ double csv_number(const CsvFile& f, const CsvTable& t, std::size_t row, std::siz
   char* end = nullptr;
   errno = 0;
   const double v = std::strtod(s.c_str(), &end);
-  if (s.empty() || *end != '\0' || errno == ERANGE || !std::isfinite(v))
+  // ERANGE also flags underflow (a denormal like 5e-324, which recorded sessions can hold):
+  // only an overflow to infinity is refused.
+  const bool overflow = errno == ERANGE && std::fabs(v) > 1.0;
+  if (s.empty() || *end != '\0' || overflow || !std::isfinite(v))
     csv_fail(f, t.lines[row], "column " + t.header[col] + " = '" + s + "' is not a finite number");
   return v;
 }

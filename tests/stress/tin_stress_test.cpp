@@ -89,7 +89,7 @@ struct Runner {
   }
   StampSchedule schedule(const Stroke& stroke) const {
     const HeightField field = HeightField::from_scene(scene);
-    return make_schedule(scene.tool, stroke, [&field](const Vec2& p) { return field(p); });
+    return make_schedule(scene.tool, stroke, [field](const Vec2& p) { return field(p); });
   }
 };
 

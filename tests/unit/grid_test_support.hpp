@@ -58,7 +58,7 @@ inline ErosionRule rule_of(const Scene& s) { return ErosionRule::from(s.material
 
 inline StampSchedule schedule_of(const Scene& s) {
   const HeightField field = HeightField::from_scene(s);
-  return make_schedule(s.tool, s.stroke, [&field](const Vec2& p) { return field(p); });
+  return make_schedule(s.tool, s.stroke, [field](const Vec2& p) { return field(p); });
 }
 
 // A stamp of the scene's tool at one pose.

@@ -110,7 +110,7 @@ class TerrainTyped : public ::testing::Test {
   }
   static StampSchedule schedule(const Scene& s) {
     const HeightField field = HeightField::from_scene(s);
-    return make_schedule(s.tool, s.stroke, [&field](const Vec2& p) { return field(p); });
+    return make_schedule(s.tool, s.stroke, [field](const Vec2& p) { return field(p); });
   }
   static ErosionRule rule(const Scene& s) { return ErosionRule::from(s.material, s.erosion.settle_tolerance_deg); }
   static void expect_ok(const Terrain& t, const char* when) {

@@ -85,7 +85,7 @@ inline ErosionRule rule_of(const Scene& s) { return ErosionRule::from(s.material
 
 inline StampSchedule schedule_of(const Scene& s) {
   const HeightField field = HeightField::from_scene(s);
-  return make_schedule(s.tool, s.stroke, [&field](const Vec2& p) { return field(p); });
+  return make_schedule(s.tool, s.stroke, [field](const Vec2& p) { return field(p); });
 }
 
 inline ToolStamp stamp_at(const Scene& s, Vec2 xy, double bottom_z, Vec2 motion = {1.0, 0.0},
