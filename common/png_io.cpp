@@ -2,7 +2,9 @@
 
 #include <png.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <stdexcept>
 
@@ -20,11 +22,28 @@ using File = std::unique_ptr<std::FILE, FileCloser>;
 [[noreturn]] void png_error_handler(png_structp, png_const_charp message) { throw std::runtime_error(message); }
 void png_warning_handler(png_structp, png_const_charp) {}
 
+void write_png_file(const std::filesystem::path& tmp, std::size_t width, std::size_t height, int color_type,
+                    int bit_depth, const std::vector<std::vector<png_byte>>& rows,
+                    const std::vector<std::pair<std::string, std::string>>& text);
+
 // Writes one PNG with the given colour type and 8 or 16 bits per sample; rows big-endian.
 void write_png(const std::filesystem::path& file, std::size_t width, std::size_t height, int color_type, int bit_depth,
                const std::vector<std::vector<png_byte>>& rows,
                const std::vector<std::pair<std::string, std::string>>& text) {
   write_atomically(file, [&](const std::filesystem::path& tmp) {
+    try {
+      write_png_file(tmp, width, height, color_type, bit_depth, rows, text);
+    } catch (const std::runtime_error&) {
+      // Disk full, quota, read-only: the user's to fix (exit 2); write_atomically removes tmp.
+      throw InputError("cannot write " + file.string() + " (" + std::strerror(errno) + "); nothing was written");
+    }
+  });
+}
+
+void write_png_file(const std::filesystem::path& tmp, std::size_t width, std::size_t height, int color_type,
+                    int bit_depth, const std::vector<std::vector<png_byte>>& rows,
+                    const std::vector<std::pair<std::string, std::string>>& text) {
+  {
     File f(std::fopen(tmp.c_str(), "wb"));
     if (!f) throw std::runtime_error("cannot write " + tmp.string());
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, png_error_handler, png_warning_handler);
@@ -49,7 +68,8 @@ void write_png(const std::filesystem::path& file, std::size_t width, std::size_t
     }
     png_destroy_write_struct(&png, &info);
     if (std::fflush(f.get()) != 0) throw std::runtime_error("cannot write " + tmp.string());
-  });
+    if (std::fclose(f.release()) != 0) throw std::runtime_error("cannot write " + tmp.string());
+  }
 }
 }  // namespace
 

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "common/input_error.hpp"
+#include "common/scene_keys.hpp"
 
 namespace sb {
 
@@ -77,7 +78,8 @@ std::string describe(const toml::node& n) {
 // any key that nothing read (a typo, or a key of another version).
 class Fields {
  public:
-  explicit Fields(const toml::table& root) : root_(root) {}
+  explicit Fields(const toml::table& root, std::vector<SceneKey>* catalogue = nullptr)
+      : root_(root), catalogue_(catalogue) {}
 
   const toml::node* find(const std::string& key) {
     seen_.insert(key);
@@ -85,6 +87,7 @@ class Fields {
   }
 
   double number(const std::string& key, double fallback, Range range, bool required = false) {
+    note(key, "number", required ? "" : text(fallback), range.str());
     const toml::node* n = find(key);
     if (!n) {
       if (required) fail(key, "is missing; it must be a number in " + range.str());
@@ -98,6 +101,7 @@ class Fields {
   }
 
   long long integer(const std::string& key, long long fallback, long long lo, long long hi) {
+    note(key, "integer", std::to_string(fallback), "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     const toml::node* n = find(key);
     if (!n) return fallback;
     const std::string allowed = "an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
@@ -108,6 +112,7 @@ class Fields {
   }
 
   bool boolean(const std::string& key, bool fallback) {
+    note(key, "boolean", fallback ? "true" : "false", "true | false");
     const toml::node* n = find(key);
     if (!n) return fallback;
     if (!n->is_boolean()) fail(key, "= " + describe(*n) + " must be true or false");
@@ -118,6 +123,7 @@ class Fields {
     const toml::node* n = find(key);
     std::string list;
     for (const auto& a : allowed) list += (list.empty() ? "" : " | ") + a;
+    note(key, "choice", "\"" + fallback + "\"", list);
     if (!n) return fallback;
     if (!n->is_string()) fail(key, "= " + describe(*n) + " must be one of " + list);
     const std::string v = *n->value<std::string>();
@@ -128,6 +134,7 @@ class Fields {
   }
 
   std::string string(const std::string& key, bool required) {
+    note(key, "string", "", "non-empty string");
     const toml::node* n = find(key);
     if (!n) {
       if (required) fail(key, "is missing; it must be a string");
@@ -141,6 +148,10 @@ class Fields {
   // An array of numbers; `count` 0 means any length >= min_count.
   std::vector<double> numbers(const std::string& key, std::size_t count, std::size_t min_count, Range range,
                               bool required, std::vector<double> fallback = {}) {
+    std::string def;
+    for (double v : fallback) def += (def.empty() ? "" : ", ") + text(v);
+    note(key, count == 2 ? "[x, y]" : "array", required || fallback.empty() ? "" : "[" + def + "]",
+         (count ? std::to_string(count) : "at least " + std::to_string(min_count)) + " numbers in " + range.str());
     const toml::node* n = find(key);
     const std::string shape =
         count ? std::to_string(count) + " numbers" : "at least " + std::to_string(min_count) + " numbers";
@@ -171,6 +182,7 @@ class Fields {
   }
 
   std::vector<Vec2> points(const std::string& key, std::size_t min_count, bool required) {
+    note(key, "points", "", "at least " + std::to_string(min_count) + " [x, y] pairs of finite numbers");
     const toml::node* n = find(key);
     if (!n) {
       if (required) fail(key, "is missing; it must be an array of [x, y] points");
@@ -211,7 +223,28 @@ class Fields {
     }
   }
 
+  // In catalogue mode every read key is noted (once) with its type, default and range.
+  void note(const std::string& key, const std::string& type, const std::string& fallback, const std::string& allowed) {
+    if (!catalogue_) return;
+    // Keys seen only in a later pass (another tool shape) go after the key read before them.
+    for (std::size_t i = 0; i < catalogue_->size(); ++i)
+      if ((*catalogue_)[i].key == key) {
+        next_ = i + 1;
+        return;
+      }
+    next_ = std::min(next_, catalogue_->size());
+    catalogue_->insert(catalogue_->begin() + static_cast<std::ptrdiff_t>(next_), {key, type, fallback, allowed, {}});
+    ++next_;
+  }
+  static std::string text(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  }
+
   const toml::table& root_;
+  std::vector<SceneKey>* catalogue_;
+  std::size_t next_ = 0;
   std::set<std::string> seen_;
 };
 
@@ -267,6 +300,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   // [domain]
   s.domain.origin_m = f.vec2("domain.origin_m", {0.0, 0.0}, open(-1e9, 1e9));
   s.domain.size_m = f.vec2("domain.size_m", {}, positive(1e6), /*required=*/true);
+  s.crs = f.string("domain.crs", /*required=*/false);
   const double extent = std::max(s.domain.size_m.x(), s.domain.size_m.y());
 
   // [terrain]
@@ -330,6 +364,25 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
     t.rim.width_m = f.number("tool.rim_width_m",
                              0.5 * (t.shape == ToolShape::Disk ? t.radius_m : t.half_size_m.minCoeff()), tool_size);
     t.rim.forward_bias = f.number("tool.rim_forward_bias", 0.8, closed(0.0, 1.0));
+  }
+
+  // A footprint whose edges vanish next to the domain cannot be resolved by the TIN (which
+  // merges points closer than 1e-12 x extent): refuse it here, for every back-end alike.
+  if (t.shape != ToolShape::Pour) {
+    const std::vector<Vec2> fp = t.footprint_local();
+    double shortest = kInf;
+    for (std::size_t i = 0; i < fp.size(); ++i) shortest = std::min(shortest, (fp[(i + 1) % fp.size()] - fp[i]).norm());
+    const double least = 1e-9 * extent;
+    if (!(shortest >= least)) {
+      const std::string key = t.shape == ToolShape::Polygon ? "tool.polygon_m"
+                              : t.shape == ToolShape::Disk  ? "tool.radius_m"
+                                                            : "tool.size_m";
+      std::ostringstream msg;
+      msg << "gives footprint edges of " << shortest << " m, shorter than 1e-9 x the domain extent (" << least
+          << " m); use a larger tool"
+          << (t.shape == ToolShape::Polygon || t.shape == ToolShape::Box ? "" : " or fewer tool.sides");
+      Fields::fail(key, msg.str());
+    }
   }
 
   // [stroke]
@@ -423,6 +476,50 @@ Scene parse_scene(const std::string& text, const std::string& name, const std::v
   resolved << root;
   s.resolved = resolved.str();
   return s;
+}
+
+std::string scene_crs(const std::string& resolved_text) {
+  try {
+    const toml::table root = toml::parse(resolved_text);
+    return root.at_path("domain.crs").value_or(std::string());
+  } catch (const toml::parse_error&) {
+    return {};
+  }
+}
+
+std::vector<SceneKey> scene_keys() {
+  // One pass per terrain kind, tool shape and profile reaches every conditional key; the
+  // passes run at two domain sizes so that ranges scaled by the domain are shown as such.
+  const std::vector<std::vector<std::string>> variants = {
+      {},
+      {"terrain.kind=dunes"},
+      {"terrain.kind=heightmap", "terrain.path=\"terrain.png\""},
+      {"tool.shape=box"},
+      {"tool.shape=ellipse"},
+      {"tool.shape=polygon", "tool.polygon_m=[[0,0],[0.01,0],[0,0.01]]"},
+      {"tool.shape=pour", "tool.volume_m3=1e-6"},
+      {"tool.profile=sphere_cap"}};
+  auto collect = [&](double extent) {
+    std::vector<SceneKey> keys;
+    for (const auto& overrides : variants) {
+      std::ostringstream text;
+      text << "[domain]\nsize_m = [" << extent << ", " << extent << "]\n[stroke]\npath_m = [[0.1, 0.1], [0.2, 0.2]]\n";
+      toml::table root = toml::parse(text.str());
+      for (const auto& o : overrides) apply_override(root, o);
+      Scene scene;
+      Fields fields(root, &keys);
+      read_scene(fields, scene, {});
+    }
+    return keys;
+  };
+  std::vector<SceneKey> keys = collect(1.0);
+  const std::vector<SceneKey> doubled = collect(2.0);
+  for (std::size_t i = 0; i < keys.size() && i < doubled.size(); ++i) {
+    if (keys[i].allowed != doubled[i].allowed) keys[i].allowed += " x domain extent";
+    if (keys[i].default_text != doubled[i].default_text) keys[i].default_text += " x domain extent";
+    keys[i].meaning = scene_key_meaning(keys[i].key);
+  }
+  return keys;
 }
 
 Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides) {

@@ -83,6 +83,7 @@ struct Scene {
   std::string resolved;                // the effective scene (TOML) after overrides
 
   DomainSpec domain;
+  std::string crs;  // domain.crs: coordinate reference system for GIS exports ("EPSG:32633"); "" none
   TerrainSpec terrain;
   Material material;
   ErosionSpec erosion;
@@ -102,6 +103,22 @@ inline constexpr double kMaxStampCorners = 2e9;
 // disk scene to a box. Overrides apply in order.
 inline constexpr const char* kUnsetPrefix = "unset ";
 inline std::string unset_override(const std::string& key) { return kUnsetPrefix + key; }
+
+// One scene key as the validator reads it: `sandbench scene-keys` prints these, and the
+// README's scene table is checked against them.
+struct SceneKey {
+  std::string key;           // dotted, e.g. "tool.radius_m"
+  std::string type;          // number | integer | boolean | string | choice | [x, y] | array | points
+  std::string default_text;  // "" when required or depending on other keys (see meaning)
+  std::string allowed;       // range or choices, as in error messages ("x domain extent" when scaled)
+  std::string meaning;
+};
+// Every key, in file order, collected by running the validator over one scene per terrain
+// kind, tool shape and profile (so conditional keys are included). O(keys).
+std::vector<SceneKey> scene_keys();
+
+// domain.crs of a resolved scene's text (what run files store), or "" when absent or unreadable.
+std::string scene_crs(const std::string& resolved_text);
 
 // Loads and validates a scene; throws InputError naming the offending key.
 Scene load_scene(const std::filesystem::path& file, const std::vector<std::string>& overrides = {});

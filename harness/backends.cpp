@@ -11,7 +11,9 @@ std::vector<std::string> backend_names() { return {"tin", "grid"}; }
 std::unique_ptr<Terrain> make_terrain(const std::string& backend, const Scene& scene, const HeightField& initial) {
   if (backend == "tin") return tin::make_tin_terrain(scene, initial);
   if (backend == "grid") return grid::make_grid_terrain(scene, initial);
-  throw InputError("--backend " + backend + " is not a back-end; must be one of tin | grid");
+  std::string list;
+  for (const auto& n : backend_names()) list += (list.empty() ? "" : " | ") + n;
+  throw InputError("--backend " + backend + " is not a back-end; must be one of " + list);
 }
 
 }  // namespace sb

@@ -10,5 +10,6 @@ void add_compare_command(CLI::App& app);
 void add_interactive_command(CLI::App& app);
 void add_render_command(CLI::App& app);
 void add_export_command(CLI::App& app);
+void add_scene_keys_command(CLI::App& app);
 
 }  // namespace sb::cli

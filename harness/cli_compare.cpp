@@ -1,4 +1,5 @@
-// `sandbench compare SCENE [--backends tin,grid] [--out DIR] [--json] [--set k=v ...]`:
+// `sandbench compare SCENE [--backends tin,grid] [--out DIR] [--json] [--set k=v ...]
+//  [--unset key ...] [--replay SESSION]`:
 // the same schedule on each back-end (or back-end variant), a table, the summaries and pictures.
 #include <fstream>
 #include <iomanip>
@@ -13,6 +14,7 @@
 #include "harness/cli_support.hpp"
 #include "harness/compare_pictures.hpp"
 #include "harness/run_file.hpp"
+#include "harness/session_file.hpp"
 
 namespace sb::cli {
 
@@ -23,6 +25,9 @@ struct CompareOptions {
   std::string out;
   bool json = false;
   std::vector<std::string> overrides;
+  std::vector<std::string> unset;
+  std::string replay;      // a recorded session replayed on every back-end
+  bool out_given = false;  // --out '' is an error, not "no folder"
 };
 
 std::vector<std::string> split(const std::string& s, char sep) {
@@ -76,13 +81,34 @@ std::string markdown_table(const std::vector<VariantRun>& runs) {
 }
 
 void compare_command(const CompareOptions& o) {
-  PreparedScene prepared = prepare_scene(load_scene(o.scene, o.overrides));
   std::vector<Variant> variants;
   for (const auto& item : split(o.backends.empty() ? "tin,grid" : o.backends, ','))
-    variants.push_back(parse_variant(item));
+    variants.push_back(parse_variant(item, "--backends"));
   if (variants.empty()) throw InputError("--backends is empty; give e.g. tin,grid");
   const std::filesystem::path dir = o.out;
-  if (!dir.empty()) std::filesystem::create_directories(dir);
+  if (o.out_given) check_output_directory(dir, "--out", {o.scene, o.replay});
+
+  // A replayed session's own overrides (its material) come first, so --set still wins.
+  Session session;
+  std::vector<std::string> overrides = scene_overrides(o.unset, o.overrides);
+  if (!o.replay.empty()) {
+    session = read_session(o.replay, "--replay");
+    if (session.stamps.empty()) throw InputError("--replay " + o.replay + ": the session has no stamps");
+    overrides.insert(overrides.begin(), session.overrides.begin(), session.overrides.end());
+  }
+  PreparedScene prepared = prepare_scene(load_scene(o.scene, overrides));
+  if (!o.replay.empty()) {
+    validate_session(session, prepared.scene, "--replay " + o.replay);
+    prepared.schedule = session_schedule(session);
+    prepared.scene.reference = ReferenceKind::None;  // the analytic references follow the scene's stroke
+  }
+  // A folder being written holds this marker until its last picture is there, so a killed
+  // compare leaves a folder that says it is incomplete.
+  const std::filesystem::path marker = dir / "INCOMPLETE";
+  if (o.out_given) {
+    std::filesystem::create_directories(dir);
+    std::ofstream(marker) << "sandbench compare is writing this folder, or was stopped before finishing it\n";
+  }
 
   std::vector<VariantRun> runs;
   for (const Variant& v : variants) runs.push_back(run_variant(v, prepared, /*show_progress=*/true));
@@ -103,7 +129,7 @@ void compare_command(const CompareOptions& o) {
   }
 
   const std::string table = markdown_table(runs);
-  if (!dir.empty()) {
+  if (o.out_given) {
     for (const auto& r : runs)
       write_run_file(dir / default_run_path(o.scene, r.run.label).filename(), r.run, r.prepared, r.summary);
     write_atomically(dir / "summary.json",
@@ -113,6 +139,7 @@ void compare_command(const CompareOptions& o) {
     for (const auto& r : runs)
       pictures.push_back({r.run.label, &r.run.final_mesh, &r.run.initial_raster, &r.run.final_raster, &r.summary});
     write_compare_pictures(dir, pictures);
+    std::filesystem::remove(marker);
     std::cerr << "wrote " << dir.string() << "/{*.h5,summary.json,table.md,side_by_side.png"
               << (runs.size() > 1 ? ",difference.png}\n" : "}\n");
   }
@@ -131,7 +158,11 @@ void add_compare_command(CLI::App& app) {
   cmd->add_option("--backends", opts->backends,
                   "Comma-separated back-ends or variants (default tin,grid), e.g. grid,grid:grid.storage=float");
   cmd->add_option("--out", opts->out,
-                  "Directory for run files, summary.json, table.md, side_by_side.png and difference.png");
+                  "Directory for run files, summary.json, table.md, side_by_side.png and difference.png")
+      ->each([opts](const std::string&) { opts->out_given = true; });
+  cmd->add_option("--replay", opts->replay,
+                  "Replay a session recorded by `sandbench interactive --record` on every back-end, side by side");
+  cmd->add_option("--unset", opts->unset, "Remove a scene key (before --set): --unset tool.radius_m")->take_all();
   cmd->add_flag("--json", opts->json, "Print the report as JSON on stdout");
   cmd->add_option("--set", opts->overrides, "Override a scene key: --set tool.radius_m=0.03")->take_all();
   cmd->callback([opts] { compare_command(*opts); });

@@ -3,7 +3,9 @@
 #include <iostream>
 #include <memory>
 
+#include "common/atomic_file.hpp"
 #include "common/input_error.hpp"
+#include "common/scene.hpp"
 #include "harness/cli_commands.hpp"
 #include "harness/export.hpp"
 #include "harness/render_mesh.hpp"
@@ -27,16 +29,20 @@ std::string attribute(const RunFile& r, const char* key) {
 void export_command(const ExportOptions& o) {
   const ExportFormat format = parse_export_format(o.format);
   const std::filesystem::path out = o.out;
-  if (out.has_parent_path() && !std::filesystem::is_directory(out.parent_path()))
-    throw InputError("-o " + out.string() + ": directory " + out.parent_path().string() + " does not exist");
-  if (std::filesystem::is_directory(out)) throw InputError("-o " + out.string() + " is a directory; give a file name");
+  check_output_path(out, "-o", {o.run});
+  if (format == ExportFormat::Png16) {
+    std::filesystem::path aux = out;
+    aux += ".aux.xml";
+    check_output_path(aux, "-o (its GDAL sidecar)", {o.run});
+  }
   const RunFile run = read_run_file(o.run);
   const std::string label = attribute(run, "label").empty() ? attribute(run, "backend") : attribute(run, "label");
   const std::vector<std::string> comments = {
       std::string("sandbench ") + kVersion + " export of " + std::filesystem::path(o.run).filename().string(),
       "backend " + label, "scene " + attribute(run, "scene_path")};
   if (format == ExportFormat::Png16) {
-    const HeightmapKeys k = export_png16(out, run.final_raster, comments[0] + ", backend " + label);
+    const HeightmapKeys k = export_png16(out, run.final_raster, comments[0] + ", backend " + label,
+                                         scene_crs(attribute(run, "scene_resolved")));
     std::cerr << "wrote " << out.string() << " (" << run.final_raster.nx << " x " << run.final_raster.ny << ", step "
               << k.step_m() << " m) and " << out.string() << ".aux.xml\nreload it with:\n"
               << heightmap_scene_snippet(k, out.filename().string());

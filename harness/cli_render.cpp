@@ -4,6 +4,7 @@
 #include <iostream>
 #include <memory>
 
+#include "common/atomic_file.hpp"
 #include "common/input_error.hpp"
 #include "harness/cli_commands.hpp"
 #include "harness/render_picture.hpp"
@@ -53,9 +54,7 @@ void render_command(const RenderCliOptions& o) {
   options.wireframe = o.wireframe;
   options.contours = o.contours;
   const std::filesystem::path out = o.out;
-  if (out.has_parent_path() && !std::filesystem::is_directory(out.parent_path()))
-    throw InputError("-o " + out.string() + ": directory " + out.parent_path().string() + " does not exist");
-  if (std::filesystem::is_directory(out)) throw InputError("-o " + out.string() + " is a directory; give a file name");
+  check_output_path(out, "-o", {o.run});
 
   const RunFile run = read_run_file(o.run);
   const RenderFrame frame = make_frame({{&run.initial_raster, &run.final_raster}}, region);

@@ -18,24 +18,39 @@ ProgressFn terminal_progress(const std::string& label) {
   };
 }
 
-Variant parse_variant(const std::string& text) {
+std::function<void(long long, long long, std::size_t)> terminal_settling(const std::string& label) {
+  if (!::isatty(STDERR_FILENO)) return {};
+  return [label](long long passes, long long max_passes, std::size_t active) {
+    if (passes < 0) {
+      std::fprintf(stderr, "\r\033[K");  // settling over: clear the line
+    } else {
+      std::fprintf(stderr, "\r\033[K[%s] settling: pass %lld/%lld, %zu elements active", label.c_str(), passes,
+                   max_passes, active);
+    }
+    std::fflush(stderr);
+  };
+}
+
+Variant parse_variant(const std::string& text, const std::string& option) {
   Variant v;
   v.label = text;
   std::size_t start = 0;
   const std::size_t colon = text.find(':');
   v.backend = text.substr(0, colon);
   const auto names = backend_names();
-  if (std::find(names.begin(), names.end(), v.backend) == names.end())
-    throw InputError("--backends: \"" + v.backend +
-                     "\" is not a back-end; must be tin or grid, optionally "
-                     "followed by :key=value overrides (e.g. grid:grid.storage=float)");
+  if (std::find(names.begin(), names.end(), v.backend) == names.end()) {
+    std::string list;
+    for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+    throw InputError(option + ": \"" + v.backend + "\" is not a back-end; must be one of " + list +
+                     ", optionally followed by :key=value overrides (e.g. grid:grid.storage=float)");
+  }
   if (colon == std::string::npos) return v;
   start = colon + 1;
   while (start <= text.size()) {
     const std::size_t next = text.find(':', start);
     const std::string part = text.substr(start, next == std::string::npos ? std::string::npos : next - start);
     if (part.find('=') == std::string::npos)
-      throw InputError("--backends: \"" + part + "\" in \"" + text + "\" must be key=value");
+      throw InputError(option + ": \"" + part + "\" in \"" + text + "\" must be key=value");
     v.overrides.push_back(part);
     if (next == std::string::npos) break;
     start = next + 1;
@@ -56,10 +71,26 @@ VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_pr
   prepared.rule = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg);
 
   auto terrain = make_terrain(v.backend, prepared.scene, prepared.initial);
-  VariantRun out{
-      run_schedule(*terrain, prepared, show_progress ? terminal_progress(v.label) : ProgressFn{}), prepared, {}};
+  RunCallbacks callbacks;
+  callbacks.notice = [label = v.label](const std::string& message) {
+    std::fprintf(stderr, "\r[%s] %s\n", label.c_str(), message.c_str());
+  };
+  if (show_progress) {
+    callbacks.progress = terminal_progress(v.label);
+    callbacks.settling = terminal_settling(v.label);
+  }
+  VariantRun out{run_schedule(*terrain, prepared, callbacks), prepared, {}};
   out.run.label = v.label;
+  for (const std::string& w : out.run.warnings)
+    std::fprintf(stderr, "sandbench: warning: [%s] %s\n", v.label.c_str(), w.c_str());
   out.summary = summarize(out.run, prepared);
+  return out;
+}
+
+std::vector<std::string> scene_overrides(const std::vector<std::string>& unset, const std::vector<std::string>& set) {
+  std::vector<std::string> out;
+  for (const auto& key : unset) out.push_back(unset_override(key));
+  out.insert(out.end(), set.begin(), set.end());
   return out;
 }
 

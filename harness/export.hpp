@@ -1,6 +1,6 @@
 #pragma once
 // Exports of a run's surface for the tools researchers already use:
-//   PLY    binary little-endian; vertex x y z (float, metres, z up), triangular faces
+//   PLY    binary little-endian; vertex x y z (double, metres, z up: exact at UTM offsets), triangular faces
 //          (counter-clockwise seen from above) and every unique edge with a `constrained`
 //          flag (MeshLab, Blender, QGIS through MDAL).
 //   OBJ    text; v and f, constrained edges as `l` lines in group constrained_edges.
@@ -8,7 +8,9 @@
 //          z = height_m + value / 65535 * vertical_scale_m, PNG row 0 at the domain's
 //          maximum y, stretched over [domain] origin_m / size_m. The keys are stored as PNG
 //          text chunks (with a ready-to-paste scene snippet), and a GDAL sidecar
-//          FILE.aux.xml gives QGIS the georeference, scale and offset.
+//          FILE.aux.xml gives QGIS the georeference, scale, offset and (domain.crs) the
+//          coordinate reference system. The PNG is written first and the sidecar last, and a
+//          failed sidecar removes the PNG, so the pair appears whole.
 // Each file is written whole or not at all. Costs: O(V + T log T) for PLY (edges),
 // O(V + T) for OBJ, O(raster points) for PNG16.
 #include <filesystem>
@@ -42,7 +44,9 @@ HeightmapKeys heightmap_keys(const Raster& raster);
 Png16 quantise(const Raster& raster, const HeightmapKeys& keys);
 // The [domain] and [terrain] tables that load the file back as a heightmap.
 std::string heightmap_scene_snippet(const HeightmapKeys& keys, const std::string& png_name);
-// Writes FILE (PNG) and FILE.aux.xml (GDAL); `source` goes into the PNG's Source chunk.
-HeightmapKeys export_png16(const std::filesystem::path& file, const Raster& raster, const std::string& source);
+// Writes FILE (PNG) and FILE.aux.xml (GDAL); `source` goes into the PNG's Source chunk;
+// `crs` (e.g. "EPSG:32633", any definition GDAL accepts), when not empty, into the sidecar.
+HeightmapKeys export_png16(const std::filesystem::path& file, const Raster& raster, const std::string& source,
+                           const std::string& crs = {});
 
 }  // namespace sb

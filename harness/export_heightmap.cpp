@@ -1,10 +1,13 @@
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <stdexcept>
 
 #include "common/atomic_file.hpp"
+#include "common/input_error.hpp"
 #include "harness/export.hpp"
 
 namespace sb {
@@ -76,14 +79,16 @@ std::string heightmap_scene_snippet(const HeightmapKeys& k, const std::string& p
          "\nvertical_scale_m = " + number(k.vertical_scale_m) + "\n";
 }
 
-HeightmapKeys export_png16(const std::filesystem::path& file, const Raster& raster, const std::string& source) {
+HeightmapKeys export_png16(const std::filesystem::path& file, const Raster& raster, const std::string& source,
+                           const std::string& crs) {
   const HeightmapKeys k = heightmap_keys(raster);
   const Png16 png = quantise(raster, k);
   const double s = raster.spacing_m;
   // GDAL's sidecar: pixel-is-area georeference (pixel centres on the raster points), and the
   // scale and offset that turn values into metres.
-  const std::string aux = "<PAMDataset>\n  <GeoTransform>" + number(k.origin_m.x() - s / 2) + ", " + number(s) +
-                          ", 0, " + number(k.origin_m.y() + k.size_m.y() + s / 2) + ", 0, " + number(-s) +
+  const std::string srs = crs.empty() ? "" : "  <SRS>" + xml_escape(crs) + "</SRS>\n";
+  const std::string aux = "<PAMDataset>\n" + srs + "  <GeoTransform>" + number(k.origin_m.x() - s / 2) + ", " +
+                          number(s) + ", 0, " + number(k.origin_m.y() + k.size_m.y() + s / 2) + ", 0, " + number(-s) +
                           "</GeoTransform>\n  <Metadata>\n    <MDI key=\"source\">" + xml_escape(source) +
                           "</MDI>\n  </Metadata>\n  <PAMRasterBand band=\"1\">\n    <Description>height</Description>\n"
                           "    <UnitType>m</UnitType>\n    <Offset>" +
@@ -91,27 +96,27 @@ HeightmapKeys export_png16(const std::filesystem::path& file, const Raster& rast
                           "</Scale>\n  </PAMRasterBand>\n</PAMDataset>\n";
   std::filesystem::path aux_file = file;
   aux_file += ".aux.xml";
-  write_atomically(aux_file, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp);
-    out << aux;
-    out.close();
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
-  });
+  write_png16(file, png,
+              {{"Software", "sandbench"},
+               {"Source", source},
+               {"Description",
+                "sandbench heightmap: z = height_m + value / 65535 * vertical_scale_m (metres); "
+                "column 0 at origin x, row 0 at origin y + size y (maximum y)"},
+               {"sandbench.origin_m", pair(k.origin_m)},
+               {"sandbench.size_m", pair(k.size_m)},
+               {"sandbench.height_m", number(k.height_m)},
+               {"sandbench.vertical_scale_m", number(k.vertical_scale_m)},
+               {"sandbench.scene", heightmap_scene_snippet(k, file.filename().string())}});
   try {
-    write_png16(file, png,
-                {{"Software", "sandbench"},
-                 {"Source", source},
-                 {"Description",
-                  "sandbench heightmap: z = height_m + value / 65535 * vertical_scale_m (metres); "
-                  "column 0 at origin x, row 0 at origin y + size y (maximum y)"},
-                 {"sandbench.origin_m", pair(k.origin_m)},
-                 {"sandbench.size_m", pair(k.size_m)},
-                 {"sandbench.height_m", number(k.height_m)},
-                 {"sandbench.vertical_scale_m", number(k.vertical_scale_m)},
-                 {"sandbench.scene", heightmap_scene_snippet(k, file.filename().string())}});
+    write_atomically(aux_file, [&](const std::filesystem::path& tmp) {
+      std::ofstream out(tmp);
+      out << aux;
+      out.close();
+      if (!out) throw InputError("cannot write " + aux_file.string() + " (" + std::strerror(errno) + ")");
+    });
   } catch (...) {
     std::error_code ignored;
-    std::filesystem::remove(aux_file, ignored);
+    std::filesystem::remove(file, ignored);  // a PNG without its sidecar would lie about where it is
     throw;
   }
   return k;

@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <bit>
+#include <cerrno>
 #include <charconv>
 #include <cstring>
 #include <fstream>
@@ -85,7 +86,9 @@ void write_string(const std::filesystem::path& file, const std::string& data) {
     std::ofstream out(tmp, std::ios::binary);
     out.write(data.data(), static_cast<std::streamsize>(data.size()));
     out.close();
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+    // Disk full, quota, read-only: the user's to fix (exit 2), and nothing is left behind.
+    if (!out)
+      throw InputError("cannot write " + file.string() + " (" + std::strerror(errno) + "); nothing was written");
   });
 }
 }  // namespace
@@ -104,15 +107,16 @@ void export_ply(const std::filesystem::path& file, const SurfaceMesh& mesh, cons
   for (const auto& c : comments) out += "comment " + one_line(c) + "\n";
   out += "comment units metres, z up; edge constrained = 1 for constrained edges\n";
   out += "element vertex " + std::to_string(mesh.vertices.size()) +
-         "\nproperty float x\nproperty float y\nproperty float z\n";
+         "\nproperty double x\nproperty double y\nproperty double z\n";
   out += "element face " + std::to_string(triangles.size()) + "\nproperty list uchar int vertex_indices\n";
   out += "element edge " + std::to_string(all_edges.size()) +
          "\nproperty int vertex1\nproperty int vertex2\nproperty uchar constrained\nend_header\n";
-  out.reserve(out.size() + 12 * mesh.vertices.size() + 13 * triangles.size() + 9 * all_edges.size());
+  out.reserve(out.size() + 24 * mesh.vertices.size() + 13 * triangles.size() + 9 * all_edges.size());
   for (const Vec3& p : mesh.vertices) {
-    put(out, static_cast<float>(p.x()));
-    put(out, static_cast<float>(p.y()));
-    put(out, static_cast<float>(p.z()));
+    // Double precision: float32 steps are 0.5 m at a UTM northing of 5e6.
+    put(out, p.x());
+    put(out, p.y());
+    put(out, p.z());
   }
   for (const auto& t : triangles) {
     put(out, std::uint8_t{3});

@@ -11,12 +11,14 @@
 #include <Eigen/Geometry>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <ctime>
 #include <iostream>
 #include <memory>
 #include <optional>
 #include <thread>
 
+#include "common/atomic_file.hpp"
 #include "common/haptics/replay_device.hpp"
 #include "common/haptics/shared_pose_device.hpp"
 #include "common/haptics/udp_device.hpp"
@@ -38,11 +40,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-void require_parent(const std::string& option, const std::string& path) {
-  if (path.empty()) return;
-  const fs::path p(path);
-  if (p.has_parent_path() && !fs::is_directory(p.parent_path()))
-    throw InputError(option + " " + path + ": directory " + p.parent_path().string() + " does not exist");
+void require_parent(const std::string& option, const std::string& path, const std::string& scene) {
+  if (!path.empty()) check_output_path(path, option, {scene});
 }
 
 std::string default_record_path() {
@@ -112,7 +111,9 @@ struct GlfwSession {
     glfwSetErrorCallback(
         [](int code, const char* what) { std::cerr << "glfw: error " << code << ": " << what << "\n"; });
     if (!glfwInit())
-      throw std::runtime_error("cannot open a window: GLFW found no display (is DISPLAY set? headless: xvfb-run -a)");
+      throw InputError(
+          "cannot open a window: GLFW found no display (is DISPLAY set? headless: xvfb-run -a sandbench "
+          "interactive ...)");
   }
   ~GlfwSession() { glfwTerminate(); }
 };
@@ -128,10 +129,16 @@ void run_interactive(const InteractiveOptions& o) {
     throw InputError("--spin-us " + std::to_string(o.spin_us) + " must be in [0, one period]");
   if (o.width < 64 || o.height < 64 || o.width > 8192 || o.height > 8192)
     throw InputError("--size: width and height must be in [64, 8192]");
-  require_parent("--record", o.record);
-  require_parent("--screenshot", o.screenshot);
-  require_parent("--stats", o.stats);
-  const cli::Variant variant = cli::parse_variant(o.backend);
+  require_parent("--record", o.record, o.scene);
+  require_parent("--screenshot", o.screenshot, o.scene);
+  require_parent("--stats", o.stats, o.scene);
+  const char* x11 = std::getenv("DISPLAY");
+  const char* wayland = std::getenv("WAYLAND_DISPLAY");
+  if ((!x11 || !*x11) && (!wayland || !*wayland))
+    throw InputError(
+        "interactive needs a display and neither DISPLAY nor WAYLAND_DISPLAY is set; without one, run it "
+        "under a virtual display: xvfb-run -a sandbench interactive ...");
+  const cli::Variant variant = cli::parse_variant(o.backend, "--backend");
   std::vector<std::string> overrides = o.overrides;
   overrides.insert(overrides.end(), variant.overrides.begin(), variant.overrides.end());
   const PreparedScene prepared = prepare_scene(load_scene(o.scene, overrides));

@@ -15,6 +15,8 @@ constexpr int kPad = 6;
 std::vector<double> ticks(const ColourBar& bar) {
   std::vector<double> out;
   if (!(bar.tick_step > 0.0) || !(bar.hi > bar.lo)) return out;
+  // A non-finite or degenerate range (a damaged run file) must not loop for ever.
+  if (!std::isfinite(bar.lo) || !std::isfinite(bar.hi) || (bar.hi - bar.lo) / bar.tick_step > 1000.0) return out;
   for (double k = std::ceil(bar.lo / bar.tick_step - 1e-9); k * bar.tick_step <= bar.hi * (1 + 1e-12) + 1e-15; ++k)
     out.push_back(k * bar.tick_step);
   return out;

@@ -17,6 +17,8 @@
 
 namespace sb {
 
+// Assembled in memory (about the file's size), then written whole under a temporary name and
+// renamed; a failed write (disk full) throws InputError and leaves nothing.
 void write_run_file(const std::filesystem::path& file, const RunResult& run, const PreparedScene& prepared,
                     const Json& summary);
 

@@ -35,6 +35,9 @@ struct RunResult {
   double volume_added = 0.0;
   double max_slope_deg = 0.0;
   bool settled = false;  // erosion active set empty at the end
+  // What a researcher should know about this run (summary "warnings", printed on stderr):
+  // stamps outside the domain, a tool below the sand bed, a run that did not settle.
+  std::vector<std::string> warnings;
   ModelStats final_stats;
   std::size_t memory_bytes_peak = 0;
   Raster initial_raster;
@@ -45,6 +48,22 @@ struct RunResult {
 // Progress callback: (done, total) stamps. Called at most every few hundred milliseconds.
 using ProgressFn = std::function<void(std::size_t done, std::size_t total)>;
 
-RunResult run_schedule(Terrain& terrain, const PreparedScene& prepared, const ProgressFn& progress = {});
+struct RunCallbacks {
+  ProgressFn progress;
+  // During the settling after the stroke: passes so far, the pass budget, active elements.
+  std::function<void(long long passes, long long max_passes, std::size_t active)> settling;
+  // One-line announcements as they arise: a run of kManyStamps or more before it starts; a
+  // long run's estimate (after about a second of stamping, when the whole stroke looks
+  // longer than kLongRunSeconds); settling that takes longer than kSlowSettlingSeconds.
+  std::function<void(const std::string& message)> notice;
+};
+inline constexpr double kLongRunSeconds = 30.0;
+inline constexpr std::size_t kManyStamps = 100000;   // announced before the first stamp
+inline constexpr double kSlowSettlingSeconds = 5.0;  // settling announced after this long
+
+RunResult run_schedule(Terrain& terrain, const PreparedScene& prepared, const RunCallbacks& callbacks);
+inline RunResult run_schedule(Terrain& terrain, const PreparedScene& prepared, const ProgressFn& progress = {}) {
+  return run_schedule(terrain, prepared, RunCallbacks{progress, {}, {}});
+}
 
 }  // namespace sb

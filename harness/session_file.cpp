@@ -245,7 +245,10 @@ std::vector<std::string> tool_overrides(const ToolSpec& t) {
       break;
     case ToolShape::Polygon: {
       std::string poly;
-      for (const Vec2& p : t.polygon_m) poly += (poly.empty() ? "" : ",") + ("[" + num(p.x()) + "," + num(p.y()) + "]");
+      for (const Vec2& p : t.polygon_m) {
+        if (!poly.empty()) poly.push_back(',');
+        poly.append("[").append(num(p.x())).append(",").append(num(p.y())).append("]");
+      }
       o.push_back("tool.polygon_m=[" + poly + "]");
       break;
     }

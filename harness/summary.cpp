@@ -83,6 +83,7 @@ Json summarize(const RunResult& run, const PreparedScene& p) {
   // Accuracy against the scene's analytic reference, when it names one.
   const Json accuracy = accuracy_metrics(p.scene, p.schedule, p.initial, run.initial_raster, run.final_raster);
   for (const auto& [key, value] : accuracy.items()) j[key] = value;
+  j["warnings"] = run.warnings;  // also printed on stderr by the command line
   return j;
 }
 

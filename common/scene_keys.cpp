@@ -1,0 +1,65 @@
+#include "common/scene_keys.hpp"
+
+#include <map>
+
+namespace sb {
+
+std::string scene_key_meaning(const std::string& key) {
+  static const std::map<std::string, std::string> meanings = {
+      {"domain.origin_m", "lower-left corner, m"},
+      {"domain.size_m", "extent, m (the paper: diagonal 1 m, [0.7071, 0.7071])"},
+      {"domain.crs", "coordinate reference system written into GIS exports (e.g. \"EPSG:32633\")"},
+      {"terrain.kind", "initial surface"},
+      {"terrain.height_m", "flat height; base height of dunes and heightmaps"},
+      {"terrain.amplitude_m", "dunes: ridge amplitude"},
+      {"terrain.wavelength_m", "dunes: ridge wavelength"},
+      {"terrain.components", "dunes: number of ridges"},
+      {"terrain.seed", "dunes: random seed"},
+      {"terrain.path", "heightmap: 16-bit grey PNG stretched over the domain (relative to the scene file)"},
+      {"terrain.vertical_scale_m", "heightmap: z = height_m + v/65535 * scale"},
+      {"material.critical_angle_deg", "angle of repose"},
+      {"material.transfer_fraction", "fraction of a pair's excess moved per visit"},
+      {"material.stiffness_n_per_m", "haptic force model: stiffness"},
+      {"material.drag_n_s_per_m", "haptic force model: drag"},
+      {"material.friction", "haptic force model: friction"},
+      {"erosion.max_passes_per_step", "erosion passes over the active set after each stamp"},
+      {"erosion.idle_passes", "an element leaves the active set after this many visits without transfer"},
+      {"erosion.settle_tolerance_deg", "slopes up to critical + this count as stable"},
+      {"erosion.relax_at_end", "settle after the stroke (recorded as steps with stamp -1)"},
+      {"erosion.relax_max_passes", "at most this many settling passes"},
+      {"tool.shape", "footprint"},
+      {"tool.radius_m", "disk radius; pour radius"},
+      {"tool.size_m", "box: full sizes; ellipse: axes (along and across the motion)"},
+      {"tool.polygon_m", "polygon footprint in tool coordinates (x along the motion)"},
+      {"tool.sides", "disk and ellipse as n-gons"},
+      {"tool.depth_m", "tool bottom below the initial surface (when stroke.z_m is absent)"},
+      {"tool.profile", "bottom profile"},
+      {"tool.sphere_radius_m", "sphere-cap profile: sphere radius"},
+      {"tool.rim_width_m", "rim band outside the footprint where displaced sand goes (default: half the radius)"},
+      {"tool.rim_forward_bias", "rim weighting towards the motion"},
+      {"tool.volume_m3", "pour: volume poured per stamp"},
+      {"stroke.path_m", "polyline, m"},
+      {"stroke.z_m", "tool bottom z at each waypoint (default: surface - depth)"},
+      {"stroke.spacing_m", "stamps at this arc-length spacing, first and last included"},
+      {"stroke.repeat", "trace the stroke this many times"},
+      {"tin.alpha_flat_deg", "simplification threshold"},
+      {"tin.tolerance_m", "max height error of the initial TIN (greedy insertion)"},
+      {"tin.conserve_volume", "compensate the volume change of vertex removal and flips"},
+      {"tin.contour_subdivision_m", "subdivide the tool's outer contour; 0: polygon only"},
+      {"tin.snap_m", "points closer than this to a vertex reuse it"},
+      {"tin.initial_points", "start from about this many vertices; 0: as few as the terrain needs"},
+      {"tin.initial_jitter", "lattice jitter as a fraction of a cell"},
+      {"tin.contour_gap_m", "outer-to-inner contour distance; 0: 5% of the tool size"},
+      {"tin.refine_m", "erosion splits edges longer than this; 0: half the tool or pour radius"},
+      {"grid.cell_m", "node spacing"},
+      {"grid.storage", "height storage type"},
+      {"grid.neighbours", "erosion stencil (4 or 8)"},
+      {"output.raster_m", "spacing of the comparison raster (default: min(0.0025, extent/100))"},
+      {"output.energy", "record the potential energy after each step"},
+      {"reference.kind", "analytic reference for the accuracy metrics"},
+  };
+  const auto it = meanings.find(key);
+  return it == meanings.end() ? std::string() : it->second;
+}
+
+}  // namespace sb
