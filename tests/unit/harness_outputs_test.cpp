@@ -18,8 +18,8 @@
 #include <string>
 
 #include "common/scene.hpp"
-#include "harness/run_file.hpp"
-#include "harness/session_file.hpp"
+#include "harness/io/run_file.hpp"
+#include "harness/io/session_file.hpp"
 #include "harness_test_support.hpp"
 
 namespace {

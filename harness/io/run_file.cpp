@@ -1,0 +1,420 @@
+#include "harness/io/run_file.hpp"
+
+#include <hdf5.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <stdexcept>
+
+#include "common/atomic_file.hpp"
+#include "common/input_error.hpp"
+#include "sandbench/version.hpp"
+
+namespace sb {
+
+namespace {
+
+// Owns one HDF5 identifier and closes it with the matching function.
+class Handle {
+ public:
+  Handle(hid_t id, herr_t (*close)(hid_t), const std::string& what) : id_(id), close_(close) {
+    if (id_ < 0) throw std::runtime_error("HDF5: cannot " + what);
+  }
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  ~Handle() { close_(id_); }
+  operator hid_t() const { return id_; }
+
+ private:
+  hid_t id_;
+  herr_t (*close_)(hid_t);
+};
+
+void check(herr_t status, const std::string& what) {
+  if (status < 0) throw std::runtime_error("HDF5: cannot " + what);
+}
+
+Handle group(hid_t parent, const std::string& name) {
+  return Handle(H5Gcreate2(parent, name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Gclose,
+                "create group " + name);
+}
+
+// Strings are variable-length UTF-8: any size (a fixed-length attribute is limited to 64 KiB)
+// and read by h5py as str.
+hid_t vl_string_type() {
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  if (type >= 0 && (H5Tset_size(type, H5T_VARIABLE) < 0 || H5Tset_cset(type, H5T_CSET_UTF8) < 0)) {
+    H5Tclose(type);
+    return -1;
+  }
+  return type;
+}
+
+void string_attribute(hid_t obj, const std::string& name, const std::string& value) {
+  Handle type(vl_string_type(), H5Tclose, "make a string type");
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose, "create scalar space");
+  Handle attr(H5Acreate2(obj, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
+              "create attribute " + name);
+  const char* data = value.c_str();
+  check(H5Awrite(attr, type, &data), "write attribute " + name);
+}
+
+void string_dataset(hid_t parent, const std::string& name, const std::string& value) {
+  Handle type(vl_string_type(), H5Tclose, "make a string type");
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose, "create scalar space");
+  Handle set(H5Dcreate2(parent, name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT), H5Dclose,
+             "create dataset " + name);
+  const char* data = value.c_str();
+  check(H5Dwrite(set, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, &data), "write " + name);
+}
+
+// Integers and booleans keep their type: int64 and uint8 (0 or 1).
+void integer_attribute(hid_t obj, const std::string& name, hid_t file_type, hid_t mem_type, const void* value) {
+  Handle space(H5Screate(H5S_SCALAR), H5Sclose, "create scalar space");
+  Handle attr(H5Acreate2(obj, name.c_str(), file_type, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
+              "create attribute " + name);
+  check(H5Awrite(attr, mem_type, value), "write attribute " + name);
+}
+
+void double_attribute(hid_t obj, const std::string& name, const std::vector<double>& values) {
+  const hsize_t n = values.size();
+  Handle space(n == 1 ? H5Screate(H5S_SCALAR) : H5Screate_simple(1, &n, nullptr), H5Sclose, "create space");
+  Handle attr(H5Acreate2(obj, name.c_str(), H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, H5P_DEFAULT), H5Aclose,
+              "create attribute " + name);
+  check(H5Awrite(attr, H5T_NATIVE_DOUBLE, values.data()), "write attribute " + name);
+}
+
+template <typename T>
+void dataset(hid_t parent, const std::string& name, hid_t mem_type, const T* data, std::vector<hsize_t> dims,
+             hid_t file_type = -1) {
+  Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose, "create space");
+  Handle plist(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "create property list");
+  std::size_t count = 1;
+  for (hsize_t d : dims) count *= d;
+  if (count > 4096) {  // chunk and compress large arrays
+    std::vector<hsize_t> chunk = dims;
+    chunk[0] = std::min<hsize_t>(dims[0], std::max<hsize_t>(1, 65536 / std::max<hsize_t>(1, count / dims[0])));
+    check(H5Pset_chunk(plist, static_cast<int>(chunk.size()), chunk.data()), "chunk " + name);
+    check(H5Pset_deflate(plist, 4), "compress " + name);
+  }
+  Handle set(
+      H5Dcreate2(parent, name.c_str(), file_type < 0 ? mem_type : file_type, space, H5P_DEFAULT, plist, H5P_DEFAULT),
+      H5Dclose, "create dataset " + name);
+  if (count > 0) check(H5Dwrite(set, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "write " + name);
+}
+
+void raster_dataset(hid_t parent, const std::string& name, const Raster& r) {
+  dataset(parent, name, H5T_NATIVE_DOUBLE, r.values.data(), {r.ny, r.nx});
+  Handle set(H5Dopen2(parent, name.c_str(), H5P_DEFAULT), H5Dclose, "open " + name);
+  double_attribute(set, "origin_m", {r.origin_m.x(), r.origin_m.y()});
+  double_attribute(set, "spacing_m", {r.spacing_m});
+}
+
+std::string utc_now() {
+  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&t));
+  return buf;
+}
+
+// Step fields by name, in the order they are written: real ones (double) ...
+template <typename Fn>
+void for_each_real_step_field(bool energy, Fn&& fn) {
+  fn("time_tool_s", [](const StepRecord& r) { return r.time_tool_s; });
+  fn("time_erosion_s", [](const StepRecord& r) { return r.time_erosion_s; });
+  fn("time_simplify_s", [](const StepRecord& r) { return r.time_simplify_s; });
+  fn("time_detect_s", [](const StepRecord& r) { return r.time_detect_s; });
+  fn("time_remove_s", [](const StepRecord& r) { return r.time_remove_s; });
+  fn("time_total_s", [](const StepRecord& r) { return r.total_s(); });
+  fn("volume_m3", [](const StepRecord& r) { return r.volume_m3; });
+  fn("volume_delta_tool", [](const StepRecord& r) { return r.volume_delta_tool; });
+  fn("volume_delta_erosion", [](const StepRecord& r) { return r.volume_delta_erosion; });
+  fn("volume_delta_simplify", [](const StepRecord& r) { return r.volume_delta_simplify; });
+  fn("volume_added", [](const StepRecord& r) { return r.volume_added; });
+  if (!energy) return;  // not recorded: no placeholder columns of NaN
+  fn("energy_m4", [](const StepRecord& r) { return r.energy_m4; });
+  fn("energy_delta_erosion_m4", [](const StepRecord& r) { return r.energy_delta_erosion_m4; });
+}
+
+// ... and integer ones (int64).
+template <typename Fn>
+void for_each_integer_step_field(Fn&& fn) {
+  fn("stamp", [](const StepRecord& r) { return static_cast<std::int64_t>(r.stamp); });
+  fn("vertices", [](const StepRecord& r) { return static_cast<std::int64_t>(r.vertices); });
+  fn("triangles", [](const StepRecord& r) { return static_cast<std::int64_t>(r.triangles); });
+  fn("constrained_edges", [](const StepRecord& r) { return static_cast<std::int64_t>(r.constrained_edges); });
+  fn("cells", [](const StepRecord& r) { return static_cast<std::int64_t>(r.cells); });
+  fn("bytes", [](const StepRecord& r) { return static_cast<std::int64_t>(r.bytes); });
+  fn("active", [](const StepRecord& r) { return static_cast<std::int64_t>(r.active); });
+  fn("erosion_updates", [](const StepRecord& r) { return static_cast<std::int64_t>(r.erosion_updates); });
+  fn("erosion_transfers", [](const StepRecord& r) { return static_cast<std::int64_t>(r.erosion_transfers); });
+  fn("elements_touched", [](const StepRecord& r) { return static_cast<std::int64_t>(r.elements_touched); });
+  fn("vertices_removed", [](const StepRecord& r) { return static_cast<std::int64_t>(r.removed); });
+  fn("walk_steps", [](const StepRecord& r) { return static_cast<std::int64_t>(r.walk_steps); });
+}
+
+void write_contents(hid_t file, const RunResult& run, const PreparedScene& p, const Json& summary) {
+  std::string overrides;
+  for (const auto& o : p.scene.overrides) overrides += (overrides.empty() ? "" : "\n") + o;
+  string_attribute(file, "scene_path", p.scene.path);
+  string_attribute(file, "overrides", overrides);
+  string_attribute(file, "backend", run.backend);
+  string_attribute(file, "label", run.label);
+  string_attribute(file, "version", kVersion);
+  string_attribute(file, "compiler", std::string(kCompiler) + " " + kBuildType);
+  string_attribute(file, "date", utc_now());
+  string_attribute(file, "summary", summary.dump());
+  {
+    // The scene whole, whatever its size (a stroke of 10^6 waypoints is tens of MB).
+    Handle scene = group(file, "scene");
+    string_dataset(scene, "text", p.scene.text);
+    string_dataset(scene, "resolved", p.scene.resolved);
+  }
+  {
+    Handle steps = group(file, "steps");
+    std::vector<double> column(run.steps.size());
+    for_each_real_step_field(p.scene.output.energy, [&](const char* name, auto get) {
+      for (std::size_t i = 0; i < run.steps.size(); ++i) column[i] = get(run.steps[i]);
+      dataset(steps, name, H5T_NATIVE_DOUBLE, column.data(), {run.steps.size()});
+    });
+    std::vector<std::int64_t> integers(run.steps.size());
+    for_each_integer_step_field([&](const char* name, auto get) {
+      for (std::size_t i = 0; i < run.steps.size(); ++i) integers[i] = get(run.steps[i]);
+      dataset(steps, name, H5T_NATIVE_INT64, integers.data(), {run.steps.size()}, H5T_STD_I64LE);
+    });
+  }
+  {
+    Handle g = group(file, "summary");
+    for (const auto& [key, value] : summary.items()) {
+      if (value.is_number_integer()) {
+        const std::int64_t v = value.get<std::int64_t>();
+        integer_attribute(g, key, H5T_STD_I64LE, H5T_NATIVE_INT64, &v);
+      } else if (value.is_number()) {
+        double_attribute(g, key, {value.get<double>()});
+      } else if (value.is_boolean()) {
+        const std::uint8_t v = value.get<bool>() ? 1 : 0;
+        integer_attribute(g, key, H5T_STD_U8LE, H5T_NATIVE_UINT8, &v);
+      } else if (value.is_string()) {
+        string_attribute(g, key, value.get<std::string>());
+      }
+    }
+  }
+  {
+    Handle g = group(file, "initial");
+    raster_dataset(g, "raster", run.initial_raster);
+  }
+  Handle final_group = group(file, "final");
+  raster_dataset(final_group, "raster", run.final_raster);
+  Handle mesh = group(final_group, "mesh");
+  const SurfaceMesh& m = run.final_mesh;
+  std::vector<double> xyz;
+  xyz.reserve(m.vertices.size() * 3);
+  for (const Vec3& v : m.vertices) xyz.insert(xyz.end(), {v.x(), v.y(), v.z()});
+  dataset(mesh, "vertices", H5T_NATIVE_DOUBLE, xyz.data(), {m.vertices.size(), 3});
+  dataset(mesh, "triangles", H5T_NATIVE_UINT32, m.triangles.empty() ? nullptr : m.triangles.data()->data(),
+          {m.triangles.size(), 3});
+  dataset(mesh, "constrained_edges", H5T_NATIVE_UINT32,
+          m.constrained_edges.empty() ? nullptr : m.constrained_edges.data()->data(), {m.constrained_edges.size(), 2});
+}
+
+// Reading.
+
+// A string attribute or scalar dataset, variable-length or (files before 2026-11) fixed-length.
+template <typename Read>
+std::string read_string(hid_t type_of_object, const std::string& name, Read&& read) {
+  Handle type(type_of_object, H5Tclose, "type of " + name);
+  if (H5Tget_class(type) != H5T_STRING) return {};
+  if (H5Tis_variable_str(type) > 0) {
+    Handle mem(H5Tcopy(H5T_C_S1), H5Tclose, "copy string type");
+    check(H5Tset_size(mem, H5T_VARIABLE), "size string");
+    check(H5Tset_cset(mem, H5Tget_cset(type)), "set string encoding");  // HDF5 does not convert encodings
+    char* data = nullptr;
+    check(read(static_cast<hid_t>(mem), static_cast<void*>(&data)), "read " + name);
+    std::string value = data ? data : "";
+    H5free_memory(data);
+    return value;
+  }
+  const std::size_t size = H5Tget_size(type);
+  std::string value(size, '\0');
+  Handle mem(H5Tcopy(H5T_C_S1), H5Tclose, "copy string type");
+  check(H5Tset_size(mem, size), "size string");
+  check(H5Tset_strpad(mem, H5T_STR_NULLPAD), "pad string");
+  check(H5Tset_cset(mem, H5Tget_cset(type)), "set string encoding");
+  check(read(static_cast<hid_t>(mem), static_cast<void*>(value.data())), "read " + name);
+  value.resize(value.find_last_not_of('\0') + 1);
+  return value;
+}
+
+std::string read_string_attribute(hid_t obj, const std::string& name) {
+  Handle attr(H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose, "open attribute " + name);
+  return read_string(H5Aget_type(attr), name, [&](hid_t mem, void* buf) { return H5Aread(attr, mem, buf); });
+}
+
+std::string read_string_dataset(hid_t parent, const std::string& name) {
+  Handle set(H5Dopen2(parent, name.c_str(), H5P_DEFAULT), H5Dclose, "open dataset " + name);
+  Handle space(H5Dget_space(set), H5Sclose, "space of " + name);
+  if (H5Sget_simple_extent_npoints(space) != 1) throw std::runtime_error(name + " is not a single string");
+  return read_string(H5Dget_type(set), name,
+                     [&](hid_t mem, void* buf) { return H5Dread(set, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf); });
+}
+
+std::vector<double> read_double_attribute(hid_t obj, const std::string& name) {
+  Handle attr(H5Aopen(obj, name.c_str(), H5P_DEFAULT), H5Aclose, "open attribute " + name);
+  Handle space(H5Aget_space(attr), H5Sclose, "space of " + name);
+  std::vector<double> v(std::max<hssize_t>(1, H5Sget_simple_extent_npoints(space)));
+  check(H5Aread(attr, H5T_NATIVE_DOUBLE, v.data()), "read attribute " + name);
+  return v;
+}
+
+template <typename T>
+std::vector<T> read_dataset(hid_t parent, const std::string& name, hid_t mem_type, std::vector<hsize_t>& dims) {
+  Handle set(H5Dopen2(parent, name.c_str(), H5P_DEFAULT), H5Dclose, "open dataset " + name);
+  Handle space(H5Dget_space(set), H5Sclose, "space of " + name);
+  dims.assign(static_cast<std::size_t>(H5Sget_simple_extent_ndims(space)), 0);
+  H5Sget_simple_extent_dims(space, dims.data(), nullptr);
+  std::size_t count = 1;
+  for (hsize_t d : dims) count *= d;
+  std::vector<T> data(count);
+  if (count > 0) check(H5Dread(set, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()), "read " + name);
+  return data;
+}
+
+// A raster whose shape, origin, spacing and values can be drawn and exported: anything else
+// in a (hand-edited or damaged) file is an input error naming the dataset.
+Raster read_raster(hid_t file, const std::string& name) {
+  std::vector<hsize_t> dims;
+  Raster r;
+  r.values = read_dataset<double>(file, name, H5T_NATIVE_DOUBLE, dims);
+  if (dims.size() != 2 || dims[0] < 1 || dims[1] < 1)
+    throw InputError(name + " must be a 2-D dataset of at least 1 x 1 values");
+  r.ny = dims[0];
+  r.nx = dims[1];
+  Handle set(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose, "open " + name);
+  const auto origin = read_double_attribute(set, "origin_m");
+  const auto spacing = read_double_attribute(set, "spacing_m");
+  if (origin.size() != 2 || !std::isfinite(origin[0]) || !std::isfinite(origin[1]))
+    throw InputError(name + ": attribute origin_m must be 2 finite numbers");
+  r.origin_m = Vec2(origin[0], origin[1]);
+  r.spacing_m = spacing.at(0);
+  if (spacing.size() != 1 || !std::isfinite(r.spacing_m) || !(r.spacing_m > 0.0))
+    throw InputError(name + ": attribute spacing_m must be one finite number > 0");
+  for (std::size_t i = 0; i < r.values.size(); ++i)
+    if (!std::isfinite(r.values[i]))
+      throw InputError(name + ": value at row " + std::to_string(i / r.nx) + ", column " + std::to_string(i % r.nx) +
+                       " is not finite");
+  return r;
+}
+
+herr_t collect_attribute_name(hid_t, const char* name, const H5A_info_t*, void* out) {
+  static_cast<std::vector<std::string>*>(out)->emplace_back(name);
+  return 0;
+}
+
+herr_t collect_link_name(hid_t, const char* name, const H5L_info_t*, void* out) {
+  static_cast<std::vector<std::string>*>(out)->emplace_back(name);
+  return 0;
+}
+
+}  // namespace
+
+void write_run_file(const std::filesystem::path& path, const RunResult& run, const PreparedScene& prepared,
+                    const Json& summary) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // failures become one exception, not pages of HDF5 stack
+  // The file is assembled in memory (HDF5's core driver, no backing store) and then written
+  // with plain I/O: a full disk is then our own write error. Were HDF5 writing to disk, a
+  // failed flush would leave its file open, and HDF5's exit handler crashes on it.
+  std::vector<char> image;
+  {
+    Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "create file access properties");
+    check(H5Pset_fapl_core(fapl, std::size_t{1} << 20, /*backing_store=*/0), "use the in-memory driver");
+    const std::string name = path.string() + ".in-memory";  // never touched on disk
+    Handle file(H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl), H5Fclose, "create " + path.string());
+    write_contents(file, run, prepared, summary);
+    check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush " + path.string());
+    const ssize_t size = H5Fget_file_image(file, nullptr, 0);
+    if (size < 0) throw std::runtime_error("HDF5: cannot size the file image of " + path.string());
+    image.resize(static_cast<std::size_t>(size));
+    if (H5Fget_file_image(file, image.data(), image.size()) != size)
+      throw std::runtime_error("HDF5: cannot copy the file image of " + path.string());
+  }
+  write_atomically(path, [&](const std::filesystem::path& tmp) {
+    std::FILE* f = std::fopen(tmp.c_str(), "wb");
+    bool ok = f && std::fwrite(image.data(), 1, image.size(), f) == image.size() && std::fflush(f) == 0;
+    const int error = errno;
+    if (f && std::fclose(f) != 0) ok = false;
+    // Disk full, quota, read-only: the user's to fix (exit 2); write_atomically removes tmp.
+    if (!ok)
+      throw InputError("cannot write the run file " + path.string() + " (" + std::strerror(error ? error : errno) +
+                       "); nothing was written");
+  });
+}
+
+RunFile read_run_file(const std::filesystem::path& path) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors become exceptions, not stderr noise
+  if (!std::filesystem::is_regular_file(path) || H5Fis_hdf5(path.c_str()) <= 0)
+    throw InputError("run file " + path.string() + " does not exist or is not an HDF5 file");
+  RunFile out;
+  try {
+    Handle file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose, "open " + path.string());
+    std::vector<std::string> names;
+    H5Aiterate2(file, H5_INDEX_NAME, H5_ITER_INC, nullptr, collect_attribute_name, &names);
+    for (const auto& n : names) out.attributes[n] = read_string_attribute(file, n);
+    if (!out.attributes.count("backend") || !out.attributes.count("summary"))
+      throw InputError("it is not a sandbench run file (no backend/summary attributes)");
+    if (H5Lexists(file, "scene", H5P_DEFAULT) > 0) {
+      out.attributes["scene_text"] = read_string_dataset(file, "/scene/text");
+      out.attributes["scene_resolved"] = read_string_dataset(file, "/scene/resolved");
+    }
+    out.summary = Json::parse(out.attributes["summary"], nullptr, /*allow_exceptions=*/false);
+    if (!out.summary.is_object()) throw InputError("attribute summary is not a JSON object");
+    {
+      Handle steps(H5Gopen2(file, "steps", H5P_DEFAULT), H5Gclose, "open /steps");
+      std::vector<std::string> fields;
+      H5Literate(steps, H5_INDEX_NAME, H5_ITER_INC, nullptr, collect_link_name, &fields);
+      std::vector<hsize_t> dims;
+      for (const auto& f : fields) out.steps[f] = read_dataset<double>(steps, f, H5T_NATIVE_DOUBLE, dims);
+    }
+    out.initial_raster = read_raster(file, "/initial/raster");
+    out.final_raster = read_raster(file, "/final/raster");
+    std::vector<hsize_t> dims;
+    const auto xyz = read_dataset<double>(file, "/final/mesh/vertices", H5T_NATIVE_DOUBLE, dims);
+    if (!xyz.empty() && (dims.size() != 2 || dims[1] != 3))
+      throw InputError("/final/mesh/vertices must be an n x 3 dataset");
+    for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) {
+      if (!std::isfinite(xyz[i]) || !std::isfinite(xyz[i + 1]) || !std::isfinite(xyz[i + 2]))
+        throw InputError("/final/mesh/vertices: vertex " + std::to_string(i / 3) + " is not finite");
+      out.mesh.vertices.emplace_back(xyz[i], xyz[i + 1], xyz[i + 2]);
+    }
+    const std::size_t n = out.mesh.vertices.size();
+    // Indices must name vertices: renderers and exporters index with them.
+    auto index = [&](const std::string& what, std::uint32_t v, std::size_t row) {
+      if (v >= n)
+        throw InputError(what + ": row " + std::to_string(row) + " names vertex " + std::to_string(v) + " of " +
+                         std::to_string(n));
+      return v;
+    };
+    const auto tri = read_dataset<std::uint32_t>(file, "/final/mesh/triangles", H5T_NATIVE_UINT32, dims);
+    for (std::size_t i = 0; i + 2 < tri.size(); i += 3) {
+      const std::string what = "/final/mesh/triangles";
+      out.mesh.triangles.push_back(
+          {index(what, tri[i], i / 3), index(what, tri[i + 1], i / 3), index(what, tri[i + 2], i / 3)});
+    }
+    const auto ce = read_dataset<std::uint32_t>(file, "/final/mesh/constrained_edges", H5T_NATIVE_UINT32, dims);
+    for (std::size_t i = 0; i + 1 < ce.size(); i += 2) {
+      const std::string what = "/final/mesh/constrained_edges";
+      out.mesh.constrained_edges.push_back({index(what, ce[i], i / 2), index(what, ce[i + 1], i / 2)});
+    }
+  } catch (const InputError& e) {
+    throw InputError("run file " + path.string() + ": " + e.what());
+  } catch (const std::exception& e) {
+    throw InputError("run file " + path.string() + " cannot be read: " + e.what());
+  }
+  return out;
+}
+
+}  // namespace sb
