@@ -65,6 +65,8 @@ std::string kind_of(fs::file_type t) {
       return "a FIFO";
     case fs::file_type::socket:
       return "a socket";
+    case fs::file_type::regular:
+      return "a regular file";
     default:
       return "not a regular file";
   }

@@ -494,14 +494,17 @@ std::vector<SceneKey> scene_keys() {
       {},
       {"terrain.kind=dunes"},
       {"terrain.kind=heightmap", "terrain.path=\"terrain.png\""},
-      {"tool.shape=box"},
-      {"tool.shape=ellipse"},
+      {"tool.shape=box", "tool.size_m=[0.04, 0.02]"},
+      {"tool.shape=ellipse", "tool.size_m=[0.04, 0.02]"},
       {"tool.shape=polygon", "tool.polygon_m=[[0,0],[0.01,0],[0,0.01]]"},
       {"tool.shape=pour", "tool.volume_m3=1e-6"},
       {"tool.profile=sphere_cap"}};
   auto collect = [&](double extent) {
     std::vector<SceneKey> keys;
-    for (const auto& overrides : variants) {
+    // Backwards: a later pass's new keys go right after the key before them, so reading the
+    // variants in reverse keeps the validator's order (dune keys before heightmap keys).
+    for (auto it = variants.rbegin(); it != variants.rend(); ++it) {
+      const auto& overrides = *it;
       std::ostringstream text;
       text << "[domain]\nsize_m = [" << extent << ", " << extent << "]\n[stroke]\npath_m = [[0.1, 0.1], [0.2, 0.2]]\n";
       toml::table root = toml::parse(text.str());

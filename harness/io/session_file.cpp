@@ -129,7 +129,9 @@ void write_session(const std::filesystem::path& file, const Session& s) {
     if (!s.backend.empty()) out << "# backend: " << s.backend << "\n";
     for (const auto& o : s.overrides) out << "# set " << o << "\n";
     out << "# tables: device trajectory, forces, tools, stamps (README: Interactive mode and haptics)\n";
-    haptics::write_trajectory_table(out, s.trajectory);
+    // A session without device samples (stamps only) has no trajectory table: an empty one
+    // would not read back.
+    if (!s.trajectory.samples.empty()) haptics::write_trajectory_table(out, s.trajectory);
     if (!s.forces.empty()) {
       out << join(kForceHeader) << "\n";
       for (const SessionForce& f : s.forces)

@@ -98,6 +98,13 @@ void write_header_only(const fs::path& file, std::uint32_t width, std::uint32_t 
   const std::uint32_t crc = png_crc(chunk);
   bytes.insert(bytes.end(), chunk.begin(), chunk.end());
   for (int s = 24; s >= 0; s -= 8) bytes.push_back(static_cast<unsigned char>(crc >> s));
+  // A two-byte IDAT (a zlib header): the header is read up to here before any pixel.
+  const std::vector<unsigned char> idat = {'I', 'D', 'A', 'T', 0x78, 0x9c};
+  const unsigned char idat_len[4] = {0, 0, 0, 2};
+  bytes.insert(bytes.end(), idat_len, idat_len + 4);
+  bytes.insert(bytes.end(), idat.begin(), idat.end());
+  const std::uint32_t idat_crc = png_crc(idat);
+  for (int s = 24; s >= 0; s -= 8) bytes.push_back(static_cast<unsigned char>(idat_crc >> s));
   const unsigned char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xae, 0x42, 0x60, 0x82};
   bytes.insert(bytes.end(), iend, iend + 12);
   std::ofstream(file, std::ios::binary)

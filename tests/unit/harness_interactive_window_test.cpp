@@ -170,9 +170,9 @@ TEST_F(Window, UdpBridgeDrivenByThePythonDevice) {
   const std::string py = "/usr/bin/python3 " + std::string(SB_SOURCE_DIR) + "/experiments/udp_device.py --port " +
                          std::to_string(port) + " --scene " + scene_path() +
                          " --duration 2.5 --wait 1.0 --extra-depth 0.002 --out " + client.string();
-  const std::string app = xvfb() + SB_CLI_PATH + " interactive " + scene_path() +
-                          " --backend grid --device udp:" + std::to_string(port) +
-                          " --frames 300 --size 640 400 --stats " + stats.string();
+  const std::string app =
+      xvfb() + SB_CLI_PATH + " interactive " + scene_path() + " --backend grid --device udp:" + std::to_string(port) +
+      " --frames 300 --size 640 400 --stats " + stats.string() + " --record " + (dir_ / "udp.csv").string();
   const Result r = shell("(" + py + ") & pid=$!; " + app + "; rc=$?; wait $pid || exit 9; exit $rc");
   ASSERT_EQ(r.code, 0) << r.out;
   std::cout << "[udp] " << r.out;
@@ -187,6 +187,10 @@ TEST_F(Window, UdpBridgeDrivenByThePythonDevice) {
   expect_safe_forces(s);
   EXPECT_GT(s["ticks_without_pose"].get<double>(), 0.0);  // before the driver's first pose
   EXPECT_GT(s["sim.stamps"].get<double>(), 0.0);
+  // What the UDP device recorded replays (its coordinates may be denormal, e.g. 5e-324).
+  const Result replay = shell(std::string(SB_CLI_PATH) + " run " + scene_path() + " --backend grid --replay " +
+                              (dir_ / "udp.csv").string() + " --out " + (dir_ / "udp.h5").string());
+  EXPECT_EQ(replay.code, 0) << replay.out;
 }
 
 }  // namespace
