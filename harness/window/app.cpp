@@ -132,12 +132,6 @@ void run_interactive(const InteractiveOptions& o) {
   require_parent("--record", o.record, o.scene);
   require_parent("--screenshot", o.screenshot, o.scene);
   require_parent("--stats", o.stats, o.scene);
-  const char* x11 = std::getenv("DISPLAY");
-  const char* wayland = std::getenv("WAYLAND_DISPLAY");
-  if ((!x11 || !*x11) && (!wayland || !*wayland))
-    throw InputError(
-        "interactive needs a display and neither DISPLAY nor WAYLAND_DISPLAY is set; without one, run it "
-        "under a virtual display: xvfb-run -a sandbench interactive ...");
   const Variant variant = parse_variant(o.backend, "--backend");
   std::vector<std::string> overrides = o.overrides;
   overrides.insert(overrides.end(), variant.overrides.begin(), variant.overrides.end());
@@ -145,6 +139,14 @@ void run_interactive(const InteractiveOptions& o) {
   const DeviceSpec device_spec = parse_device_spec(o.device);
   const haptics::DeviceLimits limits = scene_device_limits(prepared.initial, o.max_force_n, o.max_stiffness_n_per_m);
   std::unique_ptr<haptics::HapticDevice> device = make_device(device_spec, limits);
+  // The last input check, after the device (which reads a replay file) and before the model
+  // is built: a display to open a window on.
+  const char* x11 = std::getenv("DISPLAY");
+  const char* wayland = std::getenv("WAYLAND_DISPLAY");
+  if ((!x11 || !*x11) && (!wayland || !*wayland))
+    throw InputError(
+        "interactive needs a display and neither DISPLAY nor WAYLAND_DISPLAY is set; without one, run it "
+        "under a virtual display: xvfb-run -a sandbench interactive ...");
   if (auto* udp = dynamic_cast<haptics::UdpDevice*>(device.get()))
     std::cerr << "udp device: listening on 127.0.0.1:" << udp->port() << "\n";
   std::unique_ptr<Terrain> terrain = make_terrain(variant.backend, prepared.scene, prepared.initial);
@@ -157,7 +159,7 @@ void run_interactive(const InteractiveOptions& o) {
   glfwWindowHint(GLFW_SAMPLES, 0);
   const std::string title = "sandbench interactive - " + variant.label + " - " + o.scene;
   GLFWwindow* window = glfwCreateWindow(o.width, o.height, title.c_str(), nullptr, nullptr);
-  if (!window) throw std::runtime_error("cannot open an OpenGL 3.3 core window");
+  if (!window) throw InputError("cannot open an OpenGL 3.3 core window on this display (headless: xvfb-run -a)");
   glfwMakeContextCurrent(window);
   glfwSwapInterval(1);
   const gl::Api api = gl::load();

@@ -60,7 +60,7 @@ class Export : public ::testing::Test {
 
 struct Ply {
   std::vector<std::string> header;
-  std::vector<std::array<float, 3>> vertices;
+  std::vector<std::array<double, 3>> vertices;  // double since issue 13 (UTM-sized coordinates)
   std::vector<std::array<std::int32_t, 3>> faces;
   std::vector<std::array<std::int32_t, 2>> edges;
   std::vector<std::uint8_t> constrained;
@@ -133,7 +133,7 @@ TEST_F(Export, PlyReadsBackWithTheSameVerticesFacesAndConstrainedEdges) {
   ASSERT_EQ(ply.vertices.size(), mesh_.vertices.size());
   ASSERT_EQ(ply.faces.size(), mesh_.triangles.size());
   for (std::size_t i = 0; i < ply.vertices.size(); ++i)
-    for (int k = 0; k < 3; ++k) EXPECT_EQ(ply.vertices[i][k], static_cast<float>(mesh_.vertices[i][k]));
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(ply.vertices[i][k], mesh_.vertices[i][k]);
   for (std::size_t i = 0; i < ply.faces.size(); ++i) {
     std::multiset<int> got(ply.faces[i].begin(), ply.faces[i].end());
     std::multiset<int> want(mesh_.triangles[i].begin(), mesh_.triangles[i].end());
