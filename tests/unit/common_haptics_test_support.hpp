@@ -3,6 +3,7 @@
 #include <functional>
 
 #include "common/haptics/height_patch.hpp"
+#include "common/haptics/rendering.hpp"
 
 namespace sb::haptics::test {
 
@@ -14,6 +15,15 @@ inline ToolSpec disk(double radius_m, BottomProfile profile = BottomProfile::Fla
   t.profile = profile;
   t.sphere_radius_m = radius_m;
   return t;
+}
+
+// The force model's output sent as it is: no blend, no rate limit, no passivity control.
+inline RenderingOptions raw_rendering() {
+  RenderingOptions r;
+  r.blend_s = 0.0;
+  r.max_force_rate_n_per_s = 0.0;
+  r.passivity = false;
+  return r;
 }
 
 inline Material sand(double stiffness = 800.0, double drag = 5.0, double friction = 0.4) {
