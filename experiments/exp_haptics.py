@@ -13,7 +13,6 @@ prints the medians over 5 runs per back-end (the judged figures of issue 16).
 """
 import json
 import math
-import os
 import shutil
 import subprocess
 import sys
@@ -53,12 +52,25 @@ def replay_duration(path):
     return t[-1][0] - t[0][0]
 
 
-def replay(sandbench, backend, workdir, overrides=(), recording=RECORDING):
-    """One interactive replay run; returns (stats dict, numpy arrays of the recorded session)."""
+def replay(sandbench, backend, workdir, overrides=(), recording=None, reuse=False):
+    """One interactive replay run; returns (stats dict, numpy arrays of the recorded session).
+    reuse: keep a complete earlier run in workdir (the session and stats files are each written
+    whole or not at all, the stats last)."""
     import numpy as np
+    recording = recording or RECORDING
     workdir = Path(workdir)
     workdir.mkdir(parents=True, exist_ok=True)
     session, stats = workdir / f"{backend}_session.csv", workdir / f"{backend}_stats.json"
+    if not (reuse and session.exists() and stats.exists()):
+        _run_interactive(sandbench, backend, recording, session, stats, overrides)
+    tables = read_tables(session)
+    traj = np.array(tables[tuple(TRAJECTORY_HEADER)])
+    force = np.array(tables[tuple(FORCE_HEADER)])
+    return json.loads(stats.read_text()), {"t": force[:, 0], "f": force[:, 1:4], "depth": force[:, 4],
+                                           "z": traj[:, 3], "xy": traj[:, 1:3]}
+
+
+def _run_interactive(sandbench, backend, recording, session, stats, overrides):
     frames = int(math.ceil((replay_duration(recording) + 1.0) * 60))
     cmd = ["xvfb-run", "-a", "-s", "-screen 0 1024x768x24", str(sandbench), "interactive", str(SCENE),
            "--backend", backend, "--device", f"replay:{recording}", "--frames", str(frames),
@@ -68,11 +80,6 @@ def replay(sandbench, backend, workdir, overrides=(), recording=RECORDING):
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed ({proc.returncode}):\n{proc.stderr}")
-    tables = read_tables(session)
-    traj = np.array(tables[tuple(TRAJECTORY_HEADER)])
-    force = np.array(tables[tuple(FORCE_HEADER)])
-    return json.loads(stats.read_text()), {"t": force[:, 0], "f": force[:, 1:4], "depth": force[:, 4],
-                                           "z": traj[:, 3], "xy": traj[:, 1:3]}
 
 
 def steady_mask(rec):
@@ -127,7 +134,7 @@ def run(ctx):
     runs = {}
     for b in BACKENDS:
         sbrun.progress(f"  haptics: replaying {RECORDING.name} on {b}")
-        runs[b] = replay(ctx.sandbench, b, workdir)
+        runs[b] = replay(ctx.sandbench, b, workdir, reuse=True)
 
     fig, axes = plt.subplots(len(BACKENDS), 1, figsize=(9, 2.6 * len(BACKENDS)), sharex=True, squeeze=False)
     for ax, b in zip(axes[:, 0], BACKENDS):

@@ -104,6 +104,38 @@ void BM_ForceTick(benchmark::State& state) {
 }
 BENCHMARK(BM_ForceTick)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
+// The worst tick of the rendering: a new patch arrives every tick, so the model runs on the old
+// and on the new patch (the blend's jump) before the rate limit and the passivity controller.
+void BM_ForceTickNewPatchEveryTick(benchmark::State& state) {
+  const int backend = static_cast<int>(state.range(0));
+  Terrain& t = terrain(backend);
+  const ForceParams params = ForceParams::from(scene().material, scene().tool);
+  const PatchLayout layout = PatchLayout::for_tool(params.reach_m, 0.015);
+  const Vec2 centre(0.35, 0.35);
+  HeightPatch filled;
+  fill_patch(t, centre, layout, params, 1, filled);
+  PatchBuffer patches;
+  patches.for_each_slot([&](HeightPatch& p) { p = filled; });  // every slot holds a valid patch
+  patches.publish();
+  DeviceLimits limits;
+  limits.workspace.lo = Vec3(-1, -1, -1);
+  limits.workspace.hi = Vec3(2, 2, 2);
+  SharedPoseDevice device("bench", limits);
+  ServoCore core(device, patches, 40.0, scene().haptics);
+  core.start();
+  const double z = t.height(centre) - 0.005;
+  double now = 0.0;
+  for (auto _ : state) {
+    now += 0.001;
+    device.set_pose(Vec3(centre.x() + 0.005 * std::sin(now), centre.y(), z), 0);
+    patches.publish();
+    const ServoState s = core.step(now);
+    benchmark::DoNotOptimize(s.force_n);
+  }
+  counters(state, backend);
+}
+BENCHMARK(BM_ForceTickNewPatchEveryTick)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
 // The force model alone (no device, no hand-over).
 void BM_ForceModel(benchmark::State& state) {
   const int backend = static_cast<int>(state.range(0));
