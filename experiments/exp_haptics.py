@@ -17,6 +17,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import tomllib
 from pathlib import Path
 
 import sbrun
@@ -117,8 +118,8 @@ def metrics(stats, rec):
     }
 
 
-COLUMNS = [("force_max_n", "force max N"), ("steady_force_n", "steady |F| median N"),
-           ("steady_force_mean_n", "steady |F| mean N"), ("step_p99", "step p99 N"), ("step_p999", "step p99.9 N"),
+COLUMNS = [("force_max_n", "force max N"), ("steady_force_n", "steady force median N"),
+           ("steady_force_mean_n", "steady force mean N"), ("step_p99", "step p99 N"), ("step_p999", "step p99.9 N"),
            ("step_max", "step max N"), ("dfz_std_contact", "std dfz in contact N"),
            ("passivity_energy_j", "observer energy J"), ("servo_hz", "servo Hz"), ("tick_us_p99", "tick p99 us"),
            ("missed_deadlines", "missed")]
@@ -136,15 +137,19 @@ def run(ctx):
         sbrun.progress(f"  haptics: replaying {RECORDING.name} on {b}")
         runs[b] = replay(ctx.sandbench, b, workdir, reuse=True)
 
+    with open(SCENE, "rb") as f:
+        stiffness = min(float(tomllib.load(f).get("material", {}).get("stiffness_n_per_m", 800.0)), 2000.0)
     fig, axes = plt.subplots(len(BACKENDS), 1, figsize=(9, 2.6 * len(BACKENDS)), sharex=True, squeeze=False)
     for ax, b in zip(axes[:, 0], BACKENDS):
         rec = runs[b][1]
-        ax.plot(rec["t"], np.linalg.norm(rec["f"], axis=1), lw=0.8, label="|F|")
-        ax.plot(rec["t"], rec["f"][:, 2], lw=0.6, label="Fz")
+        ax.plot(rec["t"], stiffness * rec["depth"], lw=0.5, color="0.6", label="k d (the model's push, unrendered)")
+        ax.plot(rec["t"], np.linalg.norm(rec["f"], axis=1), lw=0.8, label="|F| sent")
+        ax.plot(rec["t"], rec["f"][:, 2], lw=0.6, label="Fz sent")
         ax.set_title(b, fontsize=9)
         ax.set_ylabel("force, N")
         ax.legend(fontsize=8, loc="upper right")
     axes[-1, 0].set_xlabel("servo time, s")
+    axes[-1, 0].set_xlim(0.0, replay_duration(RECORDING) + 0.3)  # the last pose is held afterwards
     png_time = ctx.figure(fig, "haptics_force_vs_time")
 
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -166,7 +171,9 @@ def run(ctx):
 The recorded session `experiments/haptics_stroke.csv` replayed through the 1 kHz servo on every back-end
 (`sandbench interactive ... --device replay:FILE --record --stats` under xvfb-run; one run each, real time, so
 the stamps fall where the simulation thread got to them). Steady contact: the tool at its deepest and moving.
-Per-tick change: |F(n) - F(n-1)| over every tick. The scene's `[haptics]` defaults apply (README).
+Per-tick change: the norm of F(n) - F(n-1) over every tick. The scene's `[haptics]` defaults apply (README);
+grey: k d, the push of the force model on the patch the servo held, before blending and rate limiting (the
+dips are the tool's own stamps digging out the sand under it, refilled by erosion within tens of ms).
 
 ![force versus time]({png_time})
 

@@ -2,7 +2,7 @@
 // through the servo tick on every back-end, with the simulation's part done in step every
 // 5 ticks, deterministically: stamp when the tool is in the sand and has moved a stroke spacing
 // (or gone half a spacing deeper), erode, simplify, republish the patch -- the rule of the
-// interactive simulation (harness/interactive_sim.cpp), without its threads. The rendered
+// interactive simulation (harness/interactive/sim.cpp), without its threads. The rendered
 // force must stay continuous (per-tick change within the scene's force-rate limit), finite,
 // within the device's limit and passive, and still push back as hard as the raw model does.
 #include <gtest/gtest.h>
@@ -14,8 +14,8 @@
 #include "common/haptics/replay_device.hpp"
 #include "common/haptics/servo_core.hpp"
 #include "common/metrics.hpp"
-#include "harness/backends.hpp"
-#include "harness/runner.hpp"
+#include "harness/run/backends.hpp"
+#include "harness/run/runner.hpp"
 
 namespace sb::haptics {
 namespace {
