@@ -11,6 +11,8 @@
 #include "common/haptics/servo_core.hpp"
 #include "common/haptics/shared_pose_device.hpp"
 #include "common/haptics/virtual_coupling.hpp"
+#include "common/input_error.hpp"
+#include "common/scene.hpp"
 #include "common_haptics_test_support.hpp"
 
 namespace sb::haptics {
@@ -19,19 +21,8 @@ namespace {
 const Vec2 kCentre(0.3, 0.3);
 constexpr double kDt = 0.001;
 
-DeviceLimits limits(double max_force_n = 8.0, double max_stiffness = 2000.0) {
-  DeviceLimits l;
-  l.max_force_n = max_force_n;
-  l.max_stiffness_n_per_m = max_stiffness;
-  l.workspace.lo = Vec3(0.0, 0.0, 0.0);
-  l.workspace.hi = Vec3(1.0, 1.0, 0.3);
-  return l;
-}
-
-void publish(PatchBuffer& b, const HeightPatch& p) {
-  b.back() = p;
-  b.publish();
-}
+using test::limits;
+using test::publish;
 
 TEST(HapticsForceBlend, CarriesTheJumpAndFadesItLinearlyWithinTheBlendTime) {
   ForceBlend blend(0.05);
@@ -236,6 +227,35 @@ TEST(HapticsServoRendering, ANewPatchChangesTheForceGraduallyAndTheRateLimitHold
   publish(patches, back);
   for (int i = 400; i < 500; ++i) s = core.step(i * kDt);
   EXPECT_GT(s.force_n.z(), 3.0);
+}
+
+TEST(HapticsSceneKeys, DefaultsAreTheDocumentedOnesAndBadValuesNameTheKey) {
+  const std::string base = "domain.size_m = [0.5, 0.5]\nstroke.path_m = [[0.1, 0.1], [0.2, 0.2]]\n";
+  const RenderingOptions d = parse_scene(base, "s.toml").haptics;
+  EXPECT_DOUBLE_EQ(d.blend_s, 0.05);
+  EXPECT_DOUBLE_EQ(d.max_force_rate_n_per_s, 80.0);
+  EXPECT_TRUE(d.passivity);
+  EXPECT_FALSE(d.coupling);
+  const RenderingOptions set =
+      parse_scene(base, "s.toml",
+                  {"haptics.blend_ms=20", "haptics.coupling=true", "haptics.coupling_stiffness_n_per_m=500",
+                   "haptics.passivity_control=false"})
+          .haptics;
+  EXPECT_DOUBLE_EQ(set.blend_s, 0.02);
+  EXPECT_TRUE(set.coupling);
+  EXPECT_DOUBLE_EQ(set.coupling_stiffness_n_per_m, 500.0);
+  EXPECT_FALSE(set.passivity);
+  for (const std::string bad :
+       {"haptics.blend_ms=-1", "haptics.max_force_rate_n_per_s=nan", "haptics.coupling_stiffness_n_per_m=0",
+        "haptics.tool_mass_kg=-0.1", "haptics.passivity_control=3", "haptics.blend=5"}) {
+    const std::string key = bad.substr(0, bad.find('='));
+    try {
+      parse_scene(base, "s.toml", {bad});
+      ADD_FAILURE() << bad << " was accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

@@ -17,18 +17,10 @@ namespace {
 const Vec2 kCentre(0.3, 0.3);
 
 DeviceLimits limits(double max_force_n = 4.0, double max_stiffness = 2000.0) {
-  DeviceLimits l;
-  l.max_force_n = max_force_n;
-  l.max_stiffness_n_per_m = max_stiffness;
-  l.workspace.lo = Vec3(0.0, 0.0, 0.0);
-  l.workspace.hi = Vec3(1.0, 1.0, 0.3);
-  return l;
+  return test::limits(max_force_n, max_stiffness);
 }
 
-void publish(PatchBuffer& b, const HeightPatch& p) {
-  b.back() = p;
-  b.publish();
-}
+using test::publish;
 
 TEST(HapticsServoCore, CommandsTheModelsForceWithinTheDeviceLimit) {
   SharedPoseDevice device("test", limits(4.0));
