@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "common/haptics/force_blend.hpp"
@@ -227,6 +228,36 @@ TEST(HapticsServoRendering, ANewPatchChangesTheForceGraduallyAndTheRateLimitHold
   publish(patches, back);
   for (int i = 400; i < 500; ++i) s = core.step(i * kDt);
   EXPECT_GT(s.force_n.z(), 3.0);
+}
+
+TEST(HapticsServoRendering, ANonFinitePatchSendsZeroAndDoesNotPoisonTheBlend) {
+  SharedPoseDevice device("test", limits(8.0, 2000.0));
+  PatchBuffer patches;
+  const ForceParams params = ForceParams::from(test::sand(800.0), test::disk(0.02));
+  publish(patches, test::flat_patch(0.1, kCentre, params));
+  ServoCore core(device, patches, 40.0, RenderingOptions{}, kDt);
+  core.start();
+  device.set_pose(Vec3(kCentre.x(), kCentre.y(), 0.1 - 0.002), 0);
+  ServoState s;
+  for (int i = 0; i < 100; ++i) s = core.step(i * kDt);
+  EXPECT_NEAR(s.force_n.z(), 1.6, 1e-9);
+  HeightPatch broken = test::flat_patch(std::numeric_limits<double>::quiet_NaN(), kCentre, params);
+  broken.heights.values[broken.heights.values.size() / 2] = 1e308;
+  broken.version = 2;
+  publish(patches, broken);
+  s = core.step(0.1);
+  EXPECT_TRUE(s.force_n.allFinite());
+  EXPECT_LE(s.force_n.norm(), 8.0);
+  HeightPatch good = test::flat_patch(0.1, kCentre, params);
+  good.version = 3;
+  publish(patches, good);
+  for (int i = 101; i < 300; ++i) {
+    s = core.step(i * kDt);
+    ASSERT_TRUE(s.force_n.allFinite()) << i;
+    ASSERT_TRUE(s.blend_offset_n.allFinite()) << i;
+    EXPECT_LE(s.force_step_n, 0.08 + 1e-12);
+  }
+  EXPECT_NEAR(s.force_n.z(), 1.6, 1e-9);  // the sand is felt again
 }
 
 TEST(HapticsSceneKeys, DefaultsAreTheDocumentedOnesAndBadValuesNameTheKey) {
