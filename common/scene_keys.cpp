@@ -57,6 +57,14 @@ std::string scene_key_meaning(const std::string& key) {
       {"output.raster_m", "spacing of the comparison raster (default: min(0.0025, extent/100))"},
       {"output.energy", "record the potential energy after each step"},
       {"reference.kind", "analytic reference for the accuracy metrics"},
+      {"haptics.blend_ms", "interactive servo: a new height patch's force jump fades out over this time"},
+      {"haptics.max_force_rate_n_per_s", "interactive servo: force change limit per second; 0: unlimited"},
+      {"haptics.passivity_control", "passivity controller: damping whenever the observer would go positive"},
+      {"haptics.passivity_max_force_n", "passivity controller: at most this damping force"},
+      {"haptics.coupling", "virtual coupling: the sand pushes a simulated tool tied to the device"},
+      {"haptics.coupling_stiffness_n_per_m", "virtual coupling: spring stiffness"},
+      {"haptics.coupling_damping_n_s_per_m", "virtual coupling: damping"},
+      {"haptics.tool_mass_kg", "virtual coupling: mass of the simulated tool"},
   };
   const auto it = meanings.find(key);
   return it == meanings.end() ? std::string() : it->second;
