@@ -84,10 +84,24 @@ void check_output_path(const fs::path& target, const std::string& option, const 
 }
 
 void check_output_directory(const fs::path& target, const std::string& option, const std::vector<fs::path>& inputs) {
-  // "out/" names the directory "out".
-  check_common(target.has_filename() ? target : target.parent_path(), option, inputs);
+  // "out/" names the directory "out"; missing parents are created, like the directory.
+  const fs::path dir = target.has_filename() ? target : target.parent_path();
+  if (dir.empty()) throw InputError(option + ": the path is empty; give a directory name");
+  for (const fs::path& in : inputs)
+    if (!in.empty() && same_file(dir, in))
+      throw InputError(option + " " + target.string() + ": is the input " + in.string() + "; choose another path");
   std::error_code ec;
-  const fs::file_status st = fs::symlink_status(target, ec);
+  for (fs::path up = dir.parent_path(); !up.empty(); up = up.parent_path()) {
+    const fs::file_status parent = fs::status(up, ec);
+    if (!fs::exists(parent)) {
+      if (up == up.parent_path()) break;
+      continue;
+    }
+    if (!fs::is_directory(parent))
+      throw InputError(option + " " + target.string() + ": " + up.string() + " is not a directory");
+    break;
+  }
+  const fs::file_status st = fs::symlink_status(dir, ec);
   if (fs::exists(st) && st.type() != fs::file_type::directory)
     throw InputError(option + " " + target.string() + ": is " + kind_of(st.type()) +
                      "; the output must be a directory, new or existing");

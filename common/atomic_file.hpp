@@ -21,7 +21,8 @@ void write_atomically(const std::filesystem::path& target,
 void check_output_path(const std::filesystem::path& target, const std::string& option,
                        const std::vector<std::filesystem::path>& inputs = {});
 
-// The same for an output directory (compare --out): it may exist only as a directory.
+// The same for an output directory (compare --out): it may exist only as a directory, and its
+// missing parents (created with it) must not run into a file.
 void check_output_directory(const std::filesystem::path& target, const std::string& option,
                             const std::vector<std::filesystem::path>& inputs = {});
 
