@@ -2,6 +2,7 @@
 // simulation thread. The window thread draws at display rate (capped at 60 Hz when the
 // display does not pace swaps, as under Xvfb), moves the mouse device, shows the panel and
 // hands control changes to the simulation.
+#include <epoxy/gl.h>  // before GLFW: libepoxy loads the window's GL entry points
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 #include <backends/imgui_impl_glfw.h>
@@ -26,7 +27,6 @@
 #include "harness/interactive/stats.hpp"
 #include "harness/run/backends.hpp"
 #include "harness/run/variant.hpp"
-#include "harness/window/gl.hpp"
 #include "harness/window/mouse.hpp"
 #include "harness/window/options.hpp"
 #include "harness/window/panel.hpp"
@@ -153,7 +153,9 @@ void run_interactive(const InteractiveOptions& o) {
   if (!window) throw std::runtime_error("cannot open an OpenGL 3.3 core window");
   glfwMakeContextCurrent(window);
   glfwSwapInterval(1);
-  const gl::Api api = gl::load();
+  if (epoxy_gl_version() < 33)
+    throw std::runtime_error("the window's OpenGL is " + std::to_string(epoxy_gl_version() / 10) + "." +
+                             std::to_string(epoxy_gl_version() % 10) + "; OpenGL 3.3 is needed");
   WindowInput input;
   glfwSetWindowUserPointer(window, &input);
   glfwSetScrollCallback(window, scroll_callback);  // before ImGui, which chains it
@@ -179,7 +181,7 @@ void run_interactive(const InteractiveOptions& o) {
   const Aabb2 box = prepared.scene.domain.box();
   const Vec2 centre = 0.5 * (box.lo + box.hi);
   const double z0 = prepared.initial(centre);
-  auto view = std::make_unique<TerrainView>(api, Vec3(centre.x(), centre.y(), z0), limits.workspace.lo.z() + 0.1 - 0.02,
+  auto view = std::make_unique<TerrainView>(Vec3(centre.x(), centre.y(), z0), limits.workspace.lo.z() + 0.1 - 0.02,
                                             limits.workspace.hi.z() - 0.1);
   Camera camera;
   camera.target = Vec3(centre.x(), centre.y(), z0);
