@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "common/atomic_file.hpp"
+#include "common/format.hpp"
 #include "common/haptics/csv_tables.hpp"
 #include "common/input_error.hpp"
 
@@ -27,23 +28,17 @@ const std::vector<std::string> kToolHeader{
 const std::vector<std::string> kStampHeader{"stamp",       "t",     "x",     "y",   "bottom_z",
                                             "heading_rad", "dir_x", "dir_y", "tool"};
 
-std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 // A tool's row without its index.
 std::string tool_fields(const ToolSpec& t) {
   std::string poly;
   for (const Vec2& p : t.polygon_m) {
     if (!poly.empty()) poly += ' ';
-    poly.append(num(p.x())).append(" ").append(num(p.y()));
+    poly.append(exact_number(p.x())).append(" ").append(exact_number(p.y()));
   }
-  return to_string(t.shape) + "," + num(t.radius_m) + "," + num(2.0 * t.half_size_m.x()) + "," +
-         num(2.0 * t.half_size_m.y()) + "," + std::to_string(t.sides) + "," + to_string(t.profile) + "," +
-         num(t.sphere_radius_m) + "," + num(t.depth_m) + "," + num(t.rim.width_m) + "," + num(t.rim.forward_bias) +
-         "," + num(t.pour_volume_m3) + "," + poly;
+  return to_string(t.shape) + "," + exact_number(t.radius_m) + "," + exact_number(2.0 * t.half_size_m.x()) + "," +
+         exact_number(2.0 * t.half_size_m.y()) + "," + std::to_string(t.sides) + "," + to_string(t.profile) + "," +
+         exact_number(t.sphere_radius_m) + "," + exact_number(t.depth_m) + "," + exact_number(t.rim.width_m) + "," +
+         exact_number(t.rim.forward_bias) + "," + exact_number(t.pour_volume_m3) + "," + poly;
 }
 
 std::string join(const std::vector<std::string>& v) {
@@ -132,17 +127,18 @@ void write_session(const std::filesystem::path& file, const Session& s) {
     if (!s.forces.empty()) {
       out << join(kForceHeader) << "\n";
       for (const SessionForce& f : s.forces)
-        out << num(f.t_s) << "," << num(f.force_n.x()) << "," << num(f.force_n.y()) << "," << num(f.force_n.z()) << ","
-            << num(f.penetration_m) << "\n";
+        out << exact_number(f.t_s) << "," << exact_number(f.force_n.x()) << "," << exact_number(f.force_n.y()) << ","
+            << exact_number(f.force_n.z()) << "," << exact_number(f.penetration_m) << "\n";
     }
     out << join(kToolHeader) << "\n";
     for (std::size_t i = 0; i < s.tools.size(); ++i) out << i << "," << tool_fields(s.tools[i]) << "\n";
     out << join(kStampHeader) << "\n";
     for (std::size_t i = 0; i < s.stamps.size(); ++i) {
       const SessionStamp& st = s.stamps[i];
-      out << i << "," << num(st.t_s) << "," << num(st.pose.xy.x()) << "," << num(st.pose.xy.y()) << ","
-          << num(st.pose.bottom_z) << "," << num(st.pose.heading_rad) << "," << num(st.motion_dir.x()) << ","
-          << num(st.motion_dir.y()) << "," << st.tool << "\n";
+      out << i << "," << exact_number(st.t_s) << "," << exact_number(st.pose.xy.x()) << ","
+          << exact_number(st.pose.xy.y()) << "," << exact_number(st.pose.bottom_z) << ","
+          << exact_number(st.pose.heading_rad) << "," << exact_number(st.motion_dir.x()) << ","
+          << exact_number(st.motion_dir.y()) << "," << st.tool << "\n";
     }
     out.flush();
     if (!out) throw std::runtime_error("writing " + tmp.string() + " failed");
