@@ -77,11 +77,10 @@ void put(std::string& out, T v) {
 
 }  // namespace
 
-ExportFormat parse_export_format(const std::string& text) {
-  if (text == "ply") return ExportFormat::Ply;
-  if (text == "obj") return ExportFormat::Obj;
-  if (text == "png16") return ExportFormat::Png16;
-  throw InputError("--format \"" + text + "\": must be ply, obj or png16");
+const std::map<std::string, ExportFormat>& export_formats() {
+  static const std::map<std::string, ExportFormat> table = {
+      {"ply", ExportFormat::Ply}, {"obj", ExportFormat::Obj}, {"png16", ExportFormat::Png16}};
+  return table;
 }
 
 void export_ply(const std::filesystem::path& file, const SurfaceMesh& mesh, const std::vector<std::string>& comments) {
