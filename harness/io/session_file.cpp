@@ -47,48 +47,25 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
+// A tool's row; the fields are checked by ToolSpec::problem(), as for every tool.
 ToolSpec read_tool(const CsvFile& f, const CsvTable& t, std::size_t r) {
   ToolSpec tool;
-  const std::string& shape = t.rows[r][1];
   const int line = t.lines[r];
-  if (shape == "disk")
-    tool.shape = ToolShape::Disk;
-  else if (shape == "box")
-    tool.shape = ToolShape::Box;
-  else if (shape == "ellipse")
-    tool.shape = ToolShape::Ellipse;
-  else if (shape == "polygon")
-    tool.shape = ToolShape::Polygon;
-  else if (shape == "pour")
-    tool.shape = ToolShape::Pour;
-  else
-    csv_fail(f, line, "column shape = '" + shape + "' must be disk | box | ellipse | polygon | pour");
-  auto positive = [&](std::size_t col) {
-    const double v = csv_number(f, t, r, col);
-    if (!(v > 0.0)) csv_fail(f, line, "column " + t.header[col] + " = " + t.rows[r][col] + " must be > 0");
-    return v;
-  };
-  tool.radius_m = positive(2);
-  tool.half_size_m = Vec2(positive(3), positive(4)) / 2.0;
+  const auto shape = tool_shape_from(t.rows[r][1]);
+  if (!shape) csv_fail(f, line, "column shape = '" + t.rows[r][1] + "' must be disk | box | ellipse | polygon | pour");
+  tool.shape = *shape;
+  tool.radius_m = csv_number(f, t, r, 2);
+  tool.half_size_m = Vec2(csv_number(f, t, r, 3), csv_number(f, t, r, 4)) / 2.0;
   const std::size_t sides = csv_index(f, t, r, 5);
-  if (sides < 3 || sides > 4096) csv_fail(f, line, "column sides = " + t.rows[r][5] + " must be in [3, 4096]");
-  tool.sides = static_cast<int>(sides);
-  const std::string& profile = t.rows[r][6];
-  if (profile == "flat")
-    tool.profile = BottomProfile::Flat;
-  else if (profile == "sphere_cap")
-    tool.profile = BottomProfile::SphereCap;
-  else
-    csv_fail(f, line, "column profile = '" + profile + "' must be flat | sphere_cap");
-  tool.sphere_radius_m = positive(7);
+  tool.sides = static_cast<int>(std::min<std::size_t>(sides, 1u << 30));
+  const auto profile = bottom_profile_from(t.rows[r][6]);
+  if (!profile) csv_fail(f, line, "column profile = '" + t.rows[r][6] + "' must be flat | sphere_cap");
+  tool.profile = *profile;
+  tool.sphere_radius_m = csv_number(f, t, r, 7);
   tool.depth_m = csv_number(f, t, r, 8);
   tool.rim.width_m = csv_number(f, t, r, 9);
   tool.rim.forward_bias = csv_number(f, t, r, 10);
-  if (tool.rim.width_m < 0.0 || tool.rim.forward_bias < 0.0 || tool.rim.forward_bias > 1.0)
-    csv_fail(f, line, "columns rim_width_m >= 0 and rim_forward_bias in [0, 1] required");
   tool.pour_volume_m3 = csv_number(f, t, r, 11);
-  if (tool.shape == ToolShape::Pour && !(tool.pour_volume_m3 > 0.0))
-    csv_fail(f, line, "column pour_volume_m3 must be > 0 for a pour tool");
   std::istringstream poly(t.rows[r][12]);
   std::vector<double> xy;
   for (std::string w; poly >> w;) {
@@ -99,8 +76,7 @@ ToolSpec read_tool(const CsvFile& f, const CsvTable& t, std::size_t r) {
   }
   if (xy.size() % 2 != 0) csv_fail(f, line, "column polygon_m must hold x y pairs");
   for (std::size_t i = 0; i < xy.size(); i += 2) tool.polygon_m.emplace_back(xy[i], xy[i + 1]);
-  if (tool.shape == ToolShape::Polygon && (tool.polygon_m.size() < 3 || !is_simple_polygon(tool.polygon_m)))
-    csv_fail(f, line, "column polygon_m must be a simple polygon of at least 3 points");
+  if (const auto problem = tool.problem()) csv_fail(f, line, *problem);
   return tool;
 }
 
