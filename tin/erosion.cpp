@@ -3,6 +3,7 @@
 // that exchange sand first get edges no longer than refine_m_ (long edges are split at their
 // middle): a pile poured on a coarse TIN can only spread if the mesh refines where the sand
 // goes, and sand on a vertex with far-reaching triangles would be spread thinly over them.
+#include <algorithm>
 #include <cmath>
 
 #include "common/input_error.hpp"
@@ -24,6 +25,12 @@ double TinTerrain::gather_neighbours(VertexHandle v) {
   return cached_area(v);
 }
 
+double TinTerrain::largest_excess_height(double z, const ErosionRule& rule) const {
+  double largest = 0.0;
+  for (const ErosionNeighbour& n : nbr_scratch_) largest = std::max(largest, z - n.z - n.distance * rule.tan_critical);
+  return largest;
+}
+
 VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* inserted) {
   const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
   const Vec2 m = 0.5 * (xy(a) + xy(b));
@@ -31,7 +38,8 @@ VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* insert
   const VertexHandle v = insert_point(m, height(m), inserted);
   const CaptureResult measured = end_capture(capture);
   if (!*inserted) return v;
-  // The split itself keeps the surface; the Delaunay flips after it may not.
+  // The split itself keeps the surface; the Delaunay flips after it may not: their volume
+  // change is given back to the new vertex (tin.conserve_volume, the default).
   if (spec_.conserve_volume && measured.delta() != 0.0) {
     const double area = vertex_area(v);
     if (area > 0.0) set_z(v, v->point().z() - measured.delta() / area);
@@ -72,7 +80,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& bu
       rule.tan_critical < 0.0 || rule.fraction < 0.0)
     throw InputError("erosion: the rule's slopes and fraction must be finite and non-negative");
   ErosionReport report;
-  std::vector<VertexHandle> work;
+  std::vector<VertexHandle>& work = work_scratch_;
   for (int pass = 0; pass < budget.max_passes && !erosion_list_.empty() && report.updates < budget.max_updates;
        ++pass) {
     ++report.passes;
@@ -95,21 +103,33 @@ ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& bu
         transfer_scratch_.resize(nbr_scratch_.size());
         total = erosion_transfers(v->point().z(), area, nbr_scratch_, rule, transfer_scratch_);
       }
-      if (total > 0.0 && area > 0.0) {
+      // Settling criterion: where no neighbour lies more than settle_dz_ below the critical
+      // slope from v, the sand left to move changes no height by more than settle_dz_ (and the
+      // potential energy by less than its volume times settle_dz_): the visit counts as idle,
+      // so relaxation ends in bounded work even where the slopes converge slowly.
+      if (total > 0.0 && area > 0.0 && largest_excess_height(v->point().z(), rule) >= settle_dz_) {
         set_z(v, v->point().z() - total / area);
+        // One ring: v fell, so its neighbours' drops towards v grew; a receiver rose, which
+        // only its own drops grow (its neighbours' drops towards it shrank).
         touch_with_neighbours(v);
         add_to_simplify(v);
         for (std::size_t k = 0; k < nbr_scratch_.size(); ++k) {
           if (transfer_scratch_[k] <= 0.0 || nbr_scratch_[k].area <= 0.0) continue;
           const VertexHandle w = vertex_scratch_[k];
           set_z(w, w->point().z() + transfer_scratch_[k] / nbr_scratch_[k].area);
-          touch_with_neighbours(w);
+          touch(w);
           add_to_simplify(w);
           ++report.transfers;
         }
         report.volume_moved_m3 += total;
       } else if (++v->info().idle >= idle_passes_) {
         drop_from_erosion(v);
+        // Settled: v and its neighbours (whose rings may now be all settled) are candidates
+        // for coarsening.
+        if (spec_.coarsen) {
+          add_to_simplify(v);
+          for (VertexHandle w : vertex_scratch_) add_to_simplify(w);
+        }
       }
     }
   }

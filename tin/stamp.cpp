@@ -117,7 +117,46 @@ bool same_border_side(const Vec2& a, const Vec2& b, const Aabb2& box) {
 
 }  // namespace
 
+void TinTerrain::drop_stale_constraints(std::uint32_t generation) {
+  std::vector<std::pair<VertexHandle, VertexHandle>> stale;
+  for (const auto& [key, g] : generations_) {
+    if (g >= generation) continue;
+    auto handle = [this](const void* p) {
+      return cdt_.tds().vertices().iterator_to(*static_cast<Tds::Vertex*>(const_cast<void*>(p)));
+    };
+    stale.emplace_back(handle(key.a), handle(key.b));
+  }
+  if (stale.empty()) return;
+  Aabb2 box{xy(stale.front().first), xy(stale.front().first)};
+  for (const auto& [a, b] : stale) box = unite(box, bounds(std::vector<Vec2>{xy(a), xy(b)}));
+  const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
+  Capture capture = begin_capture(box.expanded(4.0 * spec_.snap_m + 1e-9 * extent));
+  for (const auto& [a, b] : stale) unconstrain(a, b);
+  std::vector<VertexHandle> region_vertices;
+  const CaptureResult measured = end_capture(capture, &region_vertices);
+  for (VertexHandle v : region_vertices) {
+    v->info().area = -1.0;
+    v->info().short_edges = 0;
+  }
+  // The flips that restore the Delaunay property change the surface a little: the volume
+  // goes back to the region's vertices (a uniform lift, weighted by their areas).
+  double area = 0.0;
+  for (VertexHandle v : region_vertices) area += vertex_area(v);
+  if (spec_.conserve_volume && measured.delta() != 0.0 && area > 0.0) {
+    const double dz = -measured.delta() / area;
+    for (VertexHandle v : region_vertices) set_z(v, v->point().z() + dz);
+  }
+  for (VertexHandle v : region_vertices) {
+    touch(v);
+    add_to_simplify(v);
+  }
+}
+
 StampReport TinTerrain::stamp(const ToolStamp& s) {
+  // The constraints of stamps that have passed only kept their walls from being flipped:
+  // dropped, so the surface between old stamps is free to relax and coarsen (the Delaunay
+  // triangulation minimises roughness, Rippa 1990).
+  drop_stale_constraints(s.generation);
   if (s.is_pour()) return pour(s);
   if (s.footprint.size() < 3) throw InputError("stamp: the footprint needs at least 3 points");
   for (const Vec2& p : s.footprint)
@@ -335,6 +374,8 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   if (i_verts.size() >= 3) constrain_ring(i_verts);
 
   // 1d: heights inside lowered to the tool; the volume taken is exact (barycentric areas).
+  // A tool deeper than the bed stops at its floor, z = 0: there is no sand below to push away.
+  auto bottom = [&s](const Vec2& p) { return std::max(s.bottom_z(p), 0.0); };
   std::vector<VertexHandle> inside;
   std::vector<VertexHandle> changed;
   const Aabb2 footprint_box = intersect(bounds(footprint).expanded(margin), box_);
@@ -344,7 +385,7 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
     const Vec2 p = xy(v);
     if (!in_footprint(p)) continue;
     inside.push_back(v);
-    const double z = v->point().z(), tool = s.bottom_z(p);
+    const double z = v->point().z(), tool = bottom(p);
     if (z > tool) {
       lowered_volume += (z - tool) * vertex_area(v);
       set_z(v, tool);
@@ -359,13 +400,13 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   for (VertexHandle v : inside) {
     const Vec2 p = xy(v);
     if (is_own(v) || v->info().border || distance_to_boundary(footprint, p) <= tiny || has_constraints(v)) continue;
-    if (std::abs(v->point().z() - s.bottom_z(p)) > level_eps) continue;
+    if (std::abs(v->point().z() - bottom(p)) > level_eps) continue;
     bool deeper = false;
     auto c = cdt_.incident_vertices(v), done = c;
     do {
       if (cdt_.is_infinite(c)) continue;
       const Vec2 q = xy(c->point());
-      const double tool = in_footprint(q) ? s.bottom_z(q) : s.pose.bottom_z;
+      const double tool = in_footprint(q) ? bottom(q) : std::max(s.pose.bottom_z, 0.0);
       deeper = deeper || c->point().z() < tool - level_eps;
     } while (++c != done && !deeper);
     if (!deeper) redundant.push_back(v);

@@ -110,6 +110,10 @@ struct CaptureResult {
   double delta() const { return volume_after - volume_before; }
 };
 
+// The edge length erosion refines to when tin.refine_m is 0: 4 tin.tolerance_m / tan(critical
+// angle), at most 5 % of the domain (build.cpp).
+double default_refine_m(const Scene& scene);
+
 class TinTerrain final : public Terrain {
  public:
   explicit TinTerrain(const Scene& scene);
@@ -168,12 +172,17 @@ class TinTerrain final : public Terrain {
 
   // stamp.cpp
   StampReport pour(const ToolStamp& s);
+  // Unconstrains every edge of a generation older than `generation`, giving the volume change
+  // of the flips back to the region; O(constrained edges + region).
+  void drop_stale_constraints(std::uint32_t generation);
   // erosion.cpp: splits edge (a, b) at its middle (volume change measured, and compensated
   // under tin.conserve_volume); returns the vertex there.
   VertexHandle split_edge(VertexHandle a, VertexHandle b, bool* inserted);
   // v's neighbours (vertex_scratch_) with heights, distances and areas (nbr_scratch_); returns
   // v's area.
   double gather_neighbours(VertexHandle v);
+  // The largest height by which a gathered neighbour lies below the critical slope from z.
+  double largest_excess_height(double z, const ErosionRule& rule) const;
   // Splits v's edges longer than refine_m_ until none is; returns the number of splits.
   std::size_t refine_around(VertexHandle v);
   // build.cpp
@@ -186,6 +195,8 @@ class TinTerrain final : public Terrain {
   int idle_passes_ = 2;
   double refine_m_ = 0.0;     // edge length above which erosion splits an edge it flows across
   double tool_size_m_ = 0.0;  // characteristic radius of the scene's tool
+  double settle_dz_ = 0.0;    // erosion ignores visits where no height exceeds the slope by more
+  double tan_critical_ = 0.0;  // the scene material's, for coarsening
   TerrainKind kind_ = TerrainKind::Flat;
   double base_height_m_ = 0.0;
 
@@ -194,6 +205,7 @@ class TinTerrain final : public Terrain {
   std::vector<VertexHandle> erosion_list_;                               // L_e
   std::vector<VertexHandle> simplify_list_;                              // L_r
 
+  std::size_t hull_vertices_ = 0;  // border vertices (all on the convex hull)
   mutable VertexHandle hint_;
   mutable std::uint64_t walk_steps_ = 0;
   mutable std::uint32_t rng_ = 0x9E3779B9u;
@@ -207,6 +219,9 @@ class TinTerrain final : public Terrain {
   std::vector<VertexHandle> vertex_scratch_;
   std::vector<FaceHandle> face_scratch_;
   std::vector<VertexHandle> link_scratch_;
+  std::vector<VertexHandle> work_scratch_;       // erosion: the pass's copy of L_e
+  std::vector<VertexHandle> redundant_scratch_;  // simplify: vertices to remove
+  std::vector<VertexHandle> link_hold_scratch_;  // simplify: the removed vertex's link
 };
 
 // Area of a finite face projected on the xy plane (positive: faces are counter-clockwise).
