@@ -56,11 +56,12 @@ struct TinSpec {
   double contour_gap_m = 0.0;   // outer-to-inner contour distance; 0: 5% of the tool size
   double refine_m = 0.0;        // erosion splits edges longer than this that sand flows
                                 // across; 0: 4 tolerance_m / tan(critical angle)
-  // Simplification also removes settled vertices within this height of the plane fitted to
-  // their neighbours (volume-preserving); 0: tolerance_m / 4. coarsen = false keeps the
-  // paper's step 3 alone (vertices flatter than alpha_flat_deg).
+  // coarsen: simplification also removes settled vertices within planar_tolerance_m of the
+  // plane fitted to their neighbours (volume-preserving; 0: tolerance_m / 4). Off by default:
+  // with the edge-wise erosion rule the coarser mesh settles with triangles up to a few
+  // degrees steeper than critical. Off keeps the paper's step 3 alone (alpha_flat_deg).
   double planar_tolerance_m = 0.0;
-  bool coarsen = true;
+  bool coarsen = false;
 };
 
 enum class GridStorage { Float, Double };

@@ -7,6 +7,7 @@
 #include <numbers>
 #include <queue>
 
+#include "common/erosion.hpp"
 #include "common/input_error.hpp"
 #include "common/point_sets.hpp"
 #include "tin/detail/tin_impl.hpp"
@@ -55,10 +56,10 @@ TinTerrain::TinTerrain(const Scene& scene)
   // Never split below what snapping could merge again, nor below a ten-thousandth of the
   // domain (a 0.4 mm tool must not refine a 30 cm domain to 0.1 mm).
   refine_m_ = std::max(refine_m_, std::max(64.0 * spec_.snap_m, 1e-4 * extent));
-  // Erosion moves that change a height by less than a thousandth of the TIN's accuracy are
-  // not worth a visit (the settling criterion, erosion.cpp).
+  // A thousandth of the TIN's accuracy: what coarsening may add to an edge's height drop.
   settle_dz_ = 1e-3 * spec_.tolerance_m;
   tan_critical_ = scene.material.tan_critical();
+  tan_settle_ = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg).tan_settle;
   kind_ = scene.terrain.kind;
   base_height_m_ = scene.terrain.height_m;
 }

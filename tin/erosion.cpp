@@ -25,12 +25,6 @@ double TinTerrain::gather_neighbours(VertexHandle v) {
   return cached_area(v);
 }
 
-double TinTerrain::largest_excess_height(double z, const ErosionRule& rule) const {
-  double largest = 0.0;
-  for (const ErosionNeighbour& n : nbr_scratch_) largest = std::max(largest, z - n.z - n.distance * rule.tan_critical);
-  return largest;
-}
-
 VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* inserted) {
   const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
   const Vec2 m = 0.5 * (xy(a) + xy(b));
@@ -103,11 +97,11 @@ ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& bu
         transfer_scratch_.resize(nbr_scratch_.size());
         total = erosion_transfers(v->point().z(), area, nbr_scratch_, rule, transfer_scratch_);
       }
-      // Settling criterion: where no neighbour lies more than settle_dz_ below the critical
-      // slope from v, the sand left to move changes no height by more than settle_dz_ (and the
-      // potential energy by less than its volume times settle_dz_): the visit counts as idle,
-      // so relaxation ends in bounded work even where the slopes converge slowly.
-      if (total > 0.0 && area > 0.0 && largest_excess_height(v->point().z(), rule) >= settle_dz_) {
+      // Settling criterion (slope excess): the rule moves nothing where every slope is below
+      // tan_settle (erosion.settle_tolerance_deg above critical); a transfer removes a fixed
+      // fraction of the excess, so each slope settles in O(log(excess / tolerance)) visits,
+      // and with the mesh refined no finer than refine_m_ the work is bounded.
+      if (total > 0.0 && area > 0.0) {
         set_z(v, v->point().z() - total / area);
         // One ring: v fell, so its neighbours' drops towards v grew; a receiver rose, which
         // only its own drops grow (its neighbours' drops towards it shrank).

@@ -9,7 +9,9 @@
 // Border and constrained vertices stay. Redundant vertices are removed by CGAL (Devillers'
 // removal: the star is retriangulated as a constrained Delaunay polygon); the volume change of
 // the retriangulation is measured over the hole and given back to the hole's vertices
-// (tin.conserve_volume, the default), so removal conserves volume. Vertices whose ring is still in L_e rejoin L_r when it settles.
+// (tin.conserve_volume, the default), so removal conserves volume. Vertices whose ring is still in L_e rejoin L_r when
+// it settles.
+#include <algorithm>
 #include <cmath>
 
 #include "common/input_error.hpp"
@@ -97,6 +99,22 @@ bool removal_keeps_stable(const Cdt& cdt, VertexHandle v, double tan_critical, d
 
 }  // namespace
 
+bool TinTerrain::hole_is_steep(const std::vector<VertexHandle>& link) const {
+  auto in_link = [&link](VertexHandle w) { return std::find(link.begin(), link.end(), w) != link.end(); };
+  for (VertexHandle w : link) {
+    auto f = cdt_.incident_faces(w), done = f;
+    do {
+      if (cdt_.is_infinite(f) || !in_link(f->vertex(0)) || !in_link(f->vertex(1)) || !in_link(f->vertex(2))) continue;
+      const Point &a = f->vertex(0)->point(), &b = f->vertex(1)->point(), &c = f->vertex(2)->point();
+      const double ux = b.x() - a.x(), uy = b.y() - a.y(), uz = b.z() - a.z();
+      const double vx = c.x() - a.x(), vy = c.y() - a.y(), vz = c.z() - a.z();
+      const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+      if (std::hypot(nx, ny) > tan_settle_ * std::abs(nz)) return true;
+    } while (++f != done);
+  }
+  return false;
+}
+
 SimplifyReport TinTerrain::simplify(const SimplifyParams& params) {
   if (!std::isfinite(params.alpha_flat_deg) || params.alpha_flat_deg < 0.0 || params.alpha_flat_deg >= 90.0)
     throw InputError("simplify: alpha_flat_deg = " + std::to_string(params.alpha_flat_deg) + " must be in [0, 90)");
@@ -142,7 +160,15 @@ SimplifyReport TinTerrain::simplify(const SimplifyParams& params) {
     // Removing a vertex that is not exactly planar with its star changes the volume:
     // measured over the hole and spread back over the hole's vertices by area.
     Capture capture = begin_capture(Aabb2{p, p}.expanded(4.0 * spec_.snap_m + 1e-9 * extent));
+    const double z_before = v->point().z();
     remove_vertex(v);
+    if (hole_is_steep(link)) {
+      // Triangles can be steeper than all their edges: put the vertex back (the same point
+      // gives back the same Delaunay triangulation, so the surface is restored).
+      insert_point(p, z_before);
+      end_capture(capture);
+      continue;
+    }
     const CaptureResult measured = end_capture(capture);
     double link_area = 0.0;
     for (VertexHandle w : link) link_area += cached_area(w);

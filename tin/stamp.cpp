@@ -117,7 +117,7 @@ bool same_border_side(const Vec2& a, const Vec2& b, const Aabb2& box) {
 
 }  // namespace
 
-void TinTerrain::drop_stale_constraints(std::uint32_t generation) {
+double TinTerrain::drop_stale_constraints(std::uint32_t generation) {
   std::vector<std::pair<VertexHandle, VertexHandle>> stale;
   for (const auto& [key, g] : generations_) {
     if (g >= generation) continue;
@@ -126,7 +126,7 @@ void TinTerrain::drop_stale_constraints(std::uint32_t generation) {
     };
     stale.emplace_back(handle(key.a), handle(key.b));
   }
-  if (stale.empty()) return;
+  if (stale.empty()) return 0.0;
   Aabb2 box{xy(stale.front().first), xy(stale.front().first)};
   for (const auto& [a, b] : stale) box = unite(box, bounds(std::vector<Vec2>{xy(a), xy(b)}));
   const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
@@ -138,25 +138,21 @@ void TinTerrain::drop_stale_constraints(std::uint32_t generation) {
     v->info().area = -1.0;
     v->info().short_edges = 0;
   }
-  // The flips that restore the Delaunay property change the surface a little: the volume
-  // goes back to the region's vertices (a uniform lift, weighted by their areas).
-  double area = 0.0;
-  for (VertexHandle v : region_vertices) area += vertex_area(v);
-  if (spec_.conserve_volume && measured.delta() != 0.0 && area > 0.0) {
-    const double dz = -measured.delta() / area;
-    for (VertexHandle v : region_vertices) set_z(v, v->point().z() + dz);
-  }
   for (VertexHandle v : region_vertices) {
     touch(v);
     add_to_simplify(v);
   }
+  // The flips that restore the Delaunay property change the surface a little: the caller
+  // gives the volume back with the stamp's deposit.
+  return measured.delta();
 }
 
 StampReport TinTerrain::stamp(const ToolStamp& s) {
   // The constraints of stamps that have passed only kept their walls from being flipped:
   // dropped, so the surface between old stamps is free to relax and coarsen (the Delaunay
   // triangulation minimises roughness, Rippa 1990).
-  drop_stale_constraints(s.generation);
+  const double unconstrained = drop_stale_constraints(s.generation);
+  stale_delta_ = spec_.conserve_volume ? unconstrained : 0.0;
   if (s.is_pour()) return pour(s);
   if (s.footprint.size() < 3) throw InputError("stamp: the footprint needs at least 3 points");
   for (const Vec2& p : s.footprint)
@@ -433,7 +429,7 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
 
   // 1d (cont.): the displaced volume goes to the rim band, weighted by the common rule. The
   // band's vertices first get short edges (refine_around), so the sand stays in the band.
-  double deposit = lowered_volume - (spec_.conserve_volume ? surface_change : 0.0);
+  double deposit = lowered_volume - (spec_.conserve_volume ? surface_change : 0.0) - stale_delta_;
   const Aabb2 band_box = intersect(s.influence_bounds(), box_);
   collect_vertices(band_box, vertex_scratch_);
   std::vector<VertexHandle> band_vertices;
@@ -526,7 +522,7 @@ StampReport TinTerrain::pour(const ToolStamp& s) {
 
   // The volume lands as a cone of the pour radius (weights 1 - d / r times vertex areas), on
   // vertices with short edges (refine_around), so the sand stays within the radius.
-  const double volume = s.pour_volume_m3 - (spec_.conserve_volume ? measured.delta() : 0.0);
+  const double volume = s.pour_volume_m3 - (spec_.conserve_volume ? measured.delta() : 0.0) - stale_delta_;
   const Aabb2 reach = intersect(Aabb2{centre, centre}.expanded(radius), box_);
   collect_vertices(reach, vertex_scratch_);
   std::vector<VertexHandle> receivers;

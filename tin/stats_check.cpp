@@ -62,8 +62,8 @@ ModelStats TinTerrain::stats() const {
       (generations_.bucket_count() > 1 ? generations_.bucket_count() * sizeof(void*) : 0) + generations_.size() * node;
   bytes += vector_bytes(erosion_list_) + vector_bytes(simplify_list_) + vector_bytes(nbr_scratch_) +
            vector_bytes(transfer_scratch_) + vector_bytes(vertex_scratch_) + vector_bytes(face_scratch_) +
-           vector_bytes(link_scratch_) + vector_bytes(work_scratch_) +
-           vector_bytes(redundant_scratch_) + vector_bytes(link_hold_scratch_);
+           vector_bytes(link_scratch_) + vector_bytes(work_scratch_) + vector_bytes(redundant_scratch_) +
+           vector_bytes(link_hold_scratch_);
   st.bytes = bytes;
   return st;
 }

@@ -20,8 +20,8 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <map>
 #include <memory>
 #include <numbers>
@@ -167,21 +167,21 @@ BENCHMARK(BM_TinStep)
     ->Iterations(240)
     ->Unit(benchmark::kMicrosecond);
 
-// Collects the median (or the only) time per (conserve, border) series and N, and prints the
-// least-squares slope of log(time) against log(N).
+// Collects the median (or the only) CPU time (the machine may be shared) per (conserve, border) series and N, and
+// prints the least-squares slope of log(time) against log(N).
 class SlopeReporter : public benchmark::ConsoleReporter {
  public:
   void ReportRuns(const std::vector<Run>& runs) override {
     ConsoleReporter::ReportRuns(runs);
     for (const Run& r : runs) {
-      if (r.skipped || (r.run_type == Run::RT_Aggregate && r.aggregate_name != "median")) continue;
+      if (r.error_occurred || (r.run_type == Run::RT_Aggregate && r.aggregate_name != "median")) continue;
       if (r.run_type == Run::RT_Iteration && r.repetitions > 1) continue;
       const std::string name = r.run_name.str();  // BM_TinStep/N:1000/conserve:0/border:1
       const auto field = [&name](const std::string& key) {
         const auto at = name.find(key + ":");
         return at == std::string::npos ? -1.0 : std::stod(name.substr(at + key.size() + 1));
       };
-      series_[name.substr(name.find("/conserve"))].emplace_back(field("N"), r.GetAdjustedRealTime());
+      series_[name.substr(name.find("/conserve"))].emplace_back(field("N"), r.GetAdjustedCPUTime());
     }
   }
   void Finalize() override {
@@ -197,8 +197,7 @@ class SlopeReporter : public benchmark::ConsoleReporter {
         sxy += (std::log(n) - mx) * (std::log(t) - my);
         sxx += (std::log(n) - mx) * (std::log(n) - mx);
       }
-      std::printf("log-log slope of the step time against N%s: %.3f (%zu sizes)\n", key.c_str(), sxy / sxx,
-                  pts.size());
+      std::printf("log-log slope of the step time against N%s: %.3f (%zu sizes)\n", key.c_str(), sxy / sxx, pts.size());
     }
   }
 

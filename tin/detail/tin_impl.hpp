@@ -172,19 +172,21 @@ class TinTerrain final : public Terrain {
 
   // stamp.cpp
   StampReport pour(const ToolStamp& s);
-  // Unconstrains every edge of a generation older than `generation`, giving the volume change
-  // of the flips back to the region; O(constrained edges + region).
-  void drop_stale_constraints(std::uint32_t generation);
+  // Unconstrains every edge of a generation older than `generation` and returns the volume
+  // change of the flips (the stamp's deposit gives it back); O(constrained edges + region).
+  double drop_stale_constraints(std::uint32_t generation);
+  double stale_delta_ = 0.0;  // the current stamp's share of that change
   // erosion.cpp: splits edge (a, b) at its middle (volume change measured, and compensated
   // under tin.conserve_volume); returns the vertex there.
   VertexHandle split_edge(VertexHandle a, VertexHandle b, bool* inserted);
   // v's neighbours (vertex_scratch_) with heights, distances and areas (nbr_scratch_); returns
   // v's area.
   double gather_neighbours(VertexHandle v);
-  // The largest height by which a gathered neighbour lies below the critical slope from z.
-  double largest_excess_height(double z, const ErosionRule& rule) const;
   // Splits v's edges longer than refine_m_ until none is; returns the number of splits.
   std::size_t refine_around(VertexHandle v);
+  // simplify.cpp: whether a triangle of the retriangulated hole (all its vertices in `link`)
+  // is steeper than the stable slope.
+  bool hole_is_steep(const std::vector<VertexHandle>& link) const;
   // build.cpp
   void insert_corners(const std::function<double(const Vec2&)>& z);
   void finish_build();
@@ -193,10 +195,11 @@ class TinTerrain final : public Terrain {
   Aabb2 box_;
   TinSpec spec_;
   int idle_passes_ = 2;
-  double refine_m_ = 0.0;     // edge length above which erosion splits an edge it flows across
-  double tool_size_m_ = 0.0;  // characteristic radius of the scene's tool
-  double settle_dz_ = 0.0;    // erosion ignores visits where no height exceeds the slope by more
+  double refine_m_ = 0.0;      // edge length above which erosion splits an edge it flows across
+  double tool_size_m_ = 0.0;   // characteristic radius of the scene's tool
+  double settle_dz_ = 0.0;     // coarsening: removals may not make an edge steeper by this much
   double tan_critical_ = 0.0;  // the scene material's, for coarsening
+  double tan_settle_ = 0.0;    // and the steepest stable slope (erosion.settle_tolerance_deg)
   TerrainKind kind_ = TerrainKind::Flat;
   double base_height_m_ = 0.0;
 
