@@ -38,11 +38,13 @@ double tool_radius(const ToolSpec& t) {
 double default_refine_m(const Scene& scene) {
   // Linear interpolation over an edge of length h across a slope break of tan(critical)
   // (a pile's toe and apex, a wall's foot) errs by at most h tan / 4: the edge length at
-  // which the surface stays within tin.tolerance_m. At most 5 % of the domain.
+  // which the surface stays within tin.tolerance_m. Never finer than half the tool's radius
+  // (what a stamp resolves anyway; finer, erosion over a whole dune field refines it all),
+  // never coarser than 5 % of the domain.
   const double extent = std::max(scene.domain.size_m.x(), scene.domain.size_m.y());
   const double tan_c = scene.material.tan_critical();
   const double h = tan_c > 0.0 ? 4.0 * scene.tin.tolerance_m / tan_c : extent;
-  return std::min(h, 0.05 * extent);
+  return std::min(std::max(h, 0.5 * tool_radius(scene.tool)), 0.05 * extent);
 }
 
 TinTerrain::TinTerrain(const Scene& scene)
