@@ -169,6 +169,16 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   drop_near_duplicates(footprint, tiny);
   const double area = std::abs(signed_area(footprint));
   if (footprint.size() < 3 || !(area > 0.0)) throw InputError("stamp: the footprint has zero area");
+  // A many-sided convex tool (tool.sides up to 4096) is cut to kMaxSides evenly spaced
+  // corners: the mesh resolves no more (contour edges would be far below refine_m_), and
+  // each corner costs insertions, constraints and removals. A subset of a convex polygon's
+  // corners is convex and inscribed, so in_footprint still holds inside it.
+  constexpr std::size_t kMaxSides = 64;
+  if (footprint.size() > kMaxSides && is_convex(footprint)) {
+    std::vector<Vec2> fewer;
+    for (std::size_t k = 0; k < kMaxSides; ++k) fewer.push_back(footprint[k * footprint.size() / kMaxSides]);
+    footprint.swap(fewer);
+  }
   // Its edges become constraints, which must not cross.
   if (!is_convex(footprint) && !is_simple_polygon(footprint))
     throw InputError("stamp: the footprint must be a simple polygon (its edges cross)");

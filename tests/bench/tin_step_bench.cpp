@@ -84,8 +84,11 @@ std::unique_ptr<Setup> build(std::int64_t n, bool conserve, bool border) {
     for (std::int64_t i = 0; i < side; ++i) {
       sb::Vec2 p((static_cast<double>(i) + 0.1 + 0.8 * hash01(i - mid, j - mid, 1)) * kSpacing,
                  (static_cast<double>(j) + 0.1 + 0.8 * hash01(i - mid, j - mid, 2)) * kSpacing);
-      if (border && (i == 0 || i == side - 1)) p.x() = i == 0 ? 0.0 : size;
-      if (border && (j == 0 || j == side - 1)) p.y() = j == 0 ? 0.0 : size;
+      // The domain as parsed (its size went through text): the border exactly, nothing beyond.
+      const sb::Vec2 hi = s->scene.domain.size_m;
+      if (border && (i == 0 || i == side - 1)) p.x() = i == 0 ? 0.0 : hi.x();
+      if (border && (j == 0 || j == side - 1)) p.y() = j == 0 ? 0.0 : hi.y();
+      p = p.cwiseMin(hi);
       points.emplace_back(p.x(), p.y(), surface(p - s->centre));
     }
   s->terrain = sb::tin::make_tin_terrain_from_points(s->scene, points);
