@@ -323,13 +323,15 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   // [tin]
   s.tin.alpha_flat_deg = f.number("tin.alpha_flat_deg", 0.4, closed(0.0, 45.0));
   s.tin.tolerance_m = f.number("tin.tolerance_m", 0.001, positive(1e6));
-  s.tin.conserve_volume = f.boolean("tin.conserve_volume", false);
+  s.tin.conserve_volume = f.boolean("tin.conserve_volume", true);
   s.tin.contour_subdivision_m = f.number("tin.contour_subdivision_m", 0.0, closed(0.0, extent));
   s.tin.snap_m = f.number("tin.snap_m", 1e-6, closed(0.0, 1e-2));
   s.tin.initial_points = f.integer("tin.initial_points", 0, 0, 20000000);
   s.tin.initial_jitter = f.number("tin.initial_jitter", 0.5, closed(0.0, 0.9));
   s.tin.contour_gap_m = f.number("tin.contour_gap_m", 0.0, closed(0.0, extent));
   s.tin.refine_m = f.number("tin.refine_m", 0.0, closed(0.0, extent));
+  s.tin.planar_tolerance_m = f.number("tin.planar_tolerance_m", 0.0, closed(0.0, 1e6));
+  s.tin.coarsen = f.boolean("tin.coarsen", false);
 
   // [grid]
   s.grid.cell_m = f.number("grid.cell_m", 0.005, positive(extent));
