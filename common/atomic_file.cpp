@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstring>
+#include <fstream>
 #include <string>
 
 #include "common/input_error.hpp"
@@ -38,20 +40,6 @@ bool same_file(const fs::path& a, const fs::path& b) {
   return fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec) && !ec;
 }
 
-void check_common(const fs::path& target, const std::string& option, const std::vector<fs::path>& inputs) {
-  if (target.empty()) throw InputError(option + ": the path is empty; give a file name");
-  for (const fs::path& in : inputs)
-    if (!in.empty() && same_file(target, in))
-      throw InputError(option + " " + target.string() + ": is the input " + in.string() +
-                       "; writing there would destroy it, choose another path");
-  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw InputError(option + " " + target.string() + ": directory " + dir.string() + " does not exist");
-  if (::access(dir.c_str(), W_OK | X_OK) != 0)
-    throw InputError(option + " " + target.string() + ": directory " + dir.string() + " is not writable");
-}
-
 std::string kind_of(fs::file_type t) {
   switch (t) {
     case fs::file_type::directory:
@@ -72,24 +60,35 @@ std::string kind_of(fs::file_type t) {
   }
 }
 
-}  // namespace
-
-void check_output_path(const fs::path& target, const std::string& option, const std::vector<fs::path>& inputs) {
-  check_common(target, option, inputs);
-  std::error_code ec;
-  const fs::file_status st = fs::symlink_status(target, ec);
-  if (fs::exists(st) && st.type() != fs::file_type::regular)
-    throw InputError(option + " " + target.string() + ": is " + kind_of(st.type()) +
-                     "; the output must be a regular file, new or to be replaced");
+void throw_if(const std::string& problem, const std::string& option) {
+  if (!problem.empty()) throw InputError(option + ": " + problem);
 }
 
-void check_output_directory(const fs::path& target, const std::string& option, const std::vector<fs::path>& inputs) {
+}  // namespace
+
+std::string output_path_problem(const fs::path& target, const std::vector<fs::path>& inputs) {
+  if (target.empty()) return "the path is empty; give a file name";
+  for (const fs::path& in : inputs)
+    if (!in.empty() && same_file(target, in))
+      return target.string() + " is the input " + in.string() + "; writing there would destroy it, choose another path";
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return "directory " + dir.string() + " (of " + target.string() + ") does not exist";
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    return "directory " + dir.string() + " (of " + target.string() + ") is not writable";
+  const fs::file_status st = fs::symlink_status(target, ec);
+  if (fs::exists(st) && st.type() != fs::file_type::regular)
+    return target.string() + " is " + kind_of(st.type()) + "; the output must be a regular file, new or to be replaced";
+  return {};
+}
+
+std::string output_directory_problem(const fs::path& target, const std::vector<fs::path>& inputs) {
   // "out/" names the directory "out"; missing parents are created, like the directory.
   const fs::path dir = target.has_filename() ? target : target.parent_path();
-  if (dir.empty()) throw InputError(option + ": the path is empty; give a directory name");
+  if (dir.empty()) return "the path is empty; give a directory name";
   for (const fs::path& in : inputs)
     if (!in.empty() && same_file(dir, in))
-      throw InputError(option + " " + target.string() + ": is the input " + in.string() + "; choose another path");
+      return target.string() + " is the input " + in.string() + "; choose another path";
   std::error_code ec;
   for (fs::path up = dir.parent_path(); !up.empty(); up = up.parent_path()) {
     const fs::file_status parent = fs::status(up, ec);
@@ -97,14 +96,21 @@ void check_output_directory(const fs::path& target, const std::string& option, c
       if (up == up.parent_path()) break;
       continue;
     }
-    if (!fs::is_directory(parent))
-      throw InputError(option + " " + target.string() + ": " + up.string() + " is not a directory");
+    if (!fs::is_directory(parent)) return up.string() + " (in " + target.string() + ") is not a directory";
     break;
   }
   const fs::file_status st = fs::symlink_status(dir, ec);
   if (fs::exists(st) && st.type() != fs::file_type::directory)
-    throw InputError(option + " " + target.string() + ": is " + kind_of(st.type()) +
-                     "; the output must be a directory, new or existing");
+    return target.string() + " is " + kind_of(st.type()) + "; the output must be a directory, new or existing";
+  return {};
+}
+
+void check_output_path(const fs::path& target, const std::string& option, const std::vector<fs::path>& inputs) {
+  throw_if(output_path_problem(target, inputs), option);
+}
+
+void check_output_directory(const fs::path& target, const std::string& option, const std::vector<fs::path>& inputs) {
+  throw_if(output_directory_problem(target, inputs), option);
 }
 
 void write_atomically(const fs::path& target, const std::function<void(const fs::path&)>& write) {
@@ -119,6 +125,17 @@ void write_atomically(const fs::path& target, const std::function<void(const fs:
     fs::remove(temporary, ignored);
     throw;
   }
+}
+
+void write_text_atomically(const fs::path& target, std::string_view text) {
+  write_atomically(target, [&](const fs::path& temporary) {
+    std::ofstream out(temporary, std::ios::binary);
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    out.close();
+    // Disk full, quota, read-only: the user's to fix (exit 2), and nothing is left behind.
+    if (!out)
+      throw InputError("cannot write " + target.string() + " (" + std::strerror(errno) + "); nothing was written");
+  });
 }
 
 }  // namespace sb

@@ -336,11 +336,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   // [tool]
   const std::string shape = f.choice("tool.shape", "disk", {"disk", "box", "ellipse", "polygon", "pour"});
   ToolSpec& t = s.tool;
-  t.shape = shape == "disk"      ? ToolShape::Disk
-            : shape == "box"     ? ToolShape::Box
-            : shape == "ellipse" ? ToolShape::Ellipse
-            : shape == "polygon" ? ToolShape::Polygon
-                                 : ToolShape::Pour;
+  t.shape = *tool_shape_from(shape);
   const Range tool_size = positive(extent * 10.0);
   if (t.shape == ToolShape::Disk || t.shape == ToolShape::Pour) t.radius_m = f.number("tool.radius_m", 0.02, tool_size);
   if (t.shape == ToolShape::Box || t.shape == ToolShape::Ellipse) {
@@ -359,7 +355,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   } else {
     t.depth_m = f.number("tool.depth_m", 0.01, open(-1e6, 1e6));
     const std::string profile = f.choice("tool.profile", "flat", {"flat", "sphere_cap"});
-    t.profile = profile == "flat" ? BottomProfile::Flat : BottomProfile::SphereCap;
+    t.profile = *bottom_profile_from(profile);
     if (t.profile == BottomProfile::SphereCap) t.sphere_radius_m = f.number("tool.sphere_radius_m", 0.05, tool_size);
     t.rim.width_m = f.number("tool.rim_width_m",
                              0.5 * (t.shape == ToolShape::Disk ? t.radius_m : t.half_size_m.minCoeff()), tool_size);
@@ -399,10 +395,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   // Every stamp costs at least its footprint's vertices on every back-end: refuse runs that
   // would take hours before they start rather than after.
   const double stamps = static_cast<double>(stamp_arc_count(length, s.stroke.spacing_m)) * s.stroke.repeat;
-  const double corners = t.shape == ToolShape::Polygon ? static_cast<double>(t.polygon_m.size())
-                         : t.shape == ToolShape::Box   ? 4.0
-                         : t.shape == ToolShape::Pour  ? 1.0
-                                                       : static_cast<double>(t.sides);
+  const double corners = static_cast<double>(t.footprint_corners());
   if (stamps * corners > kMaxStampCorners) {
     std::ostringstream msg;
     msg << "gives " << stamps << " stamps of a " << corners << "-corner footprint (" << stamps * corners
@@ -414,13 +407,15 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   // [tin]
   s.tin.alpha_flat_deg = f.number("tin.alpha_flat_deg", 0.4, closed(0.0, 45.0));
   s.tin.tolerance_m = f.number("tin.tolerance_m", 0.001, positive(1e6));
-  s.tin.conserve_volume = f.boolean("tin.conserve_volume", false);
+  s.tin.conserve_volume = f.boolean("tin.conserve_volume", true);
   s.tin.contour_subdivision_m = f.number("tin.contour_subdivision_m", 0.0, closed(0.0, extent));
   s.tin.snap_m = f.number("tin.snap_m", 1e-6, closed(0.0, 1e-2));
   s.tin.initial_points = f.integer("tin.initial_points", 0, 0, 20000000);
   s.tin.initial_jitter = f.number("tin.initial_jitter", 0.5, closed(0.0, 0.9));
   s.tin.contour_gap_m = f.number("tin.contour_gap_m", 0.0, closed(0.0, extent));
   s.tin.refine_m = f.number("tin.refine_m", 0.0, closed(0.0, extent));
+  s.tin.planar_tolerance_m = f.number("tin.planar_tolerance_m", 0.0, closed(0.0, 1e6));
+  s.tin.coarsen = f.boolean("tin.coarsen", false);
 
   // [grid]
   s.grid.cell_m = f.number("grid.cell_m", 0.005, positive(extent));

@@ -10,6 +10,7 @@
 #include "common/atomic_file.hpp"
 #include "common/input_error.hpp"
 #include "harness/cli/commands.hpp"
+#include "harness/cli/validators.hpp"
 #include "harness/figures/compare_pictures.hpp"
 #include "harness/io/run_file.hpp"
 #include "harness/io/session_file.hpp"
@@ -26,8 +27,7 @@ struct CompareOptions {
   bool json = false;
   std::vector<std::string> overrides;
   std::vector<std::string> unset;
-  std::string replay;      // a recorded session replayed on every back-end
-  bool out_given = false;  // --out '' is an error, not "no folder"
+  std::string replay;  // a recorded session replayed on every back-end
 };
 
 std::vector<std::string> split(const std::string& s, char sep) {
@@ -86,7 +86,7 @@ void compare_command(const CompareOptions& o) {
     variants.push_back(parse_variant(item, "--backends"));
   if (variants.empty()) throw InputError("--backends is empty; give e.g. tin,grid");
   const std::filesystem::path dir = o.out;
-  if (o.out_given) check_output_directory(dir, "--out", {o.scene, o.replay});
+  if (!dir.empty()) check_output_directory(dir, "--out", {o.scene, o.replay});  // --out '' fails its validator
 
   // A replayed session's own overrides (its material) come first, so --set still wins.
   Session session;
@@ -105,7 +105,7 @@ void compare_command(const CompareOptions& o) {
   // A folder being written holds this marker until its last picture is there, so a killed
   // compare leaves a folder that says it is incomplete.
   const std::filesystem::path marker = dir / "INCOMPLETE";
-  if (o.out_given) {
+  if (!dir.empty()) {
     std::filesystem::create_directories(dir);
     std::ofstream(marker) << "sandbench compare is writing this folder, or was stopped before finishing it\n";
   }
@@ -129,12 +129,11 @@ void compare_command(const CompareOptions& o) {
   }
 
   const std::string table = markdown_table(runs);
-  if (o.out_given) {
+  if (!dir.empty()) {
     for (const auto& r : runs)
       write_run_file(dir / default_run_path(o.scene, r.run.label).filename(), r.run, r.prepared, r.summary);
-    write_atomically(dir / "summary.json",
-                     [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << report.dump(2) << "\n"; });
-    write_atomically(dir / "table.md", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << table; });
+    write_text_atomically(dir / "summary.json", report.dump(2) + "\n");
+    write_text_atomically(dir / "table.md", table);
     std::vector<PictureRun> pictures;
     for (const auto& r : runs)
       pictures.push_back({r.run.label, &r.run.final_mesh, &r.run.initial_raster, &r.run.final_raster, &r.summary});
@@ -159,7 +158,7 @@ void add_compare_command(CLI::App& app) {
                   "Comma-separated back-ends or variants (default tin,grid), e.g. grid,grid:grid.storage=float");
   cmd->add_option("--out", opts->out,
                   "Directory for run files, summary.json, table.md, side_by_side.png and difference.png")
-      ->each([opts](const std::string&) { opts->out_given = true; });
+      ->check(output_directory());
   cmd->add_option("--replay", opts->replay,
                   "Replay a session recorded by `sandbench interactive --record` on every back-end, side by side");
   cmd->add_option("--unset", opts->unset, "Remove a scene key (before --set): --unset tool.radius_m")->take_all();

@@ -9,7 +9,7 @@
 #include "common/input_error.hpp"
 #include "common/scene.hpp"
 #include "harness/cli/commands.hpp"
-#include "harness/io/export.hpp"
+#include "harness/cli/validators.hpp"
 #include "harness/io/run_file.hpp"
 #include "harness/render/mesh.hpp"
 #include "sandbench/version.hpp"
@@ -19,7 +19,7 @@ namespace sb::cli {
 namespace {
 struct ExportOptions {
   std::string run;
-  std::string format;
+  ExportFormat format = ExportFormat::Ply;
   std::string out;
 };
 
@@ -29,7 +29,7 @@ std::string attribute(const RunFile& r, const char* key) {
 }
 
 void export_command(const ExportOptions& o) {
-  const ExportFormat format = parse_export_format(o.format);
+  const ExportFormat format = o.format;
   const std::filesystem::path out = o.out;
   check_output_path(out, "-o", {o.run});
   if (format == ExportFormat::Png16) {
@@ -66,8 +66,8 @@ void add_export_command(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("export", "Export a run file's final surface as PLY, OBJ or a 16-bit PNG heightmap");
   cmd->add_option("run", opts->run, "Run file (HDF5) written by sandbench run or compare")->required();
-  cmd->add_option("--format", opts->format, "ply | obj | png16")->required();
-  cmd->add_option("-o,--out", opts->out, "File to write")->required();
+  cmd->add_option("--format", opts->format, "ply | obj | png16")->required()->transform(names(export_formats()));
+  cmd->add_option("-o,--out", opts->out, "File to write")->required()->check(output_file());
   cmd->callback([opts] { export_command(*opts); });
 }
 

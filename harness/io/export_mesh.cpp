@@ -1,13 +1,10 @@
 #include <algorithm>
 #include <bit>
-#include <cerrno>
-#include <charconv>
 #include <cstring>
-#include <fstream>
 #include <stdexcept>
 
 #include "common/atomic_file.hpp"
-#include "common/input_error.hpp"
+#include "common/format.hpp"
 #include "harness/io/export.hpp"
 
 namespace sb {
@@ -75,29 +72,12 @@ void put(std::string& out, T v) {
   out.append(bytes, sizeof(T));
 }
 
-void append_number(std::string& out, double v) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  out.append(buf, r.ptr);
-}
-
-void write_string(const std::filesystem::path& file, const std::string& data) {
-  write_atomically(file, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(data.data(), static_cast<std::streamsize>(data.size()));
-    out.close();
-    // Disk full, quota, read-only: the user's to fix (exit 2), and nothing is left behind.
-    if (!out)
-      throw InputError("cannot write " + file.string() + " (" + std::strerror(errno) + "); nothing was written");
-  });
-}
 }  // namespace
 
-ExportFormat parse_export_format(const std::string& text) {
-  if (text == "ply") return ExportFormat::Ply;
-  if (text == "obj") return ExportFormat::Obj;
-  if (text == "png16") return ExportFormat::Png16;
-  throw InputError("--format \"" + text + "\": must be ply, obj or png16");
+const std::map<std::string, ExportFormat>& export_formats() {
+  static const std::map<std::string, ExportFormat> table = {
+      {"ply", ExportFormat::Ply}, {"obj", ExportFormat::Obj}, {"png16", ExportFormat::Png16}};
+  return table;
 }
 
 void export_ply(const std::filesystem::path& file, const SurfaceMesh& mesh, const std::vector<std::string>& comments) {
@@ -127,7 +107,7 @@ void export_ply(const std::filesystem::path& file, const SurfaceMesh& mesh, cons
     put(out, static_cast<std::int32_t>(e.b));
     put(out, e.constrained);
   }
-  write_string(file, out);
+  write_text_atomically(file, out);
 }
 
 void export_obj(const std::filesystem::path& file, const SurfaceMesh& mesh, const std::vector<std::string>& comments) {
@@ -141,11 +121,11 @@ void export_obj(const std::filesystem::path& file, const SurfaceMesh& mesh, cons
   out.reserve(out.size() + 40 * mesh.vertices.size() + 24 * triangles.size());
   for (const Vec3& p : mesh.vertices) {
     out += "v ";
-    append_number(out, p.x());
+    out += exact_number(p.x());
     out += ' ';
-    append_number(out, p.y());
+    out += exact_number(p.y());
     out += ' ';
-    append_number(out, p.z());
+    out += exact_number(p.z());
     out += '\n';
   }
   for (const auto& t : triangles)
@@ -158,7 +138,7 @@ void export_obj(const std::filesystem::path& file, const SurfaceMesh& mesh, cons
       out += "l " + std::to_string(e[0] + 1) + " " + std::to_string(e[1] + 1) + "\n";
     }
   }
-  write_string(file, out);
+  write_text_atomically(file, out);
 }
 
 }  // namespace sb

@@ -1,13 +1,13 @@
 #include "harness/io/session_file.hpp"
 
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <sstream>
 
 #include "common/atomic_file.hpp"
+#include "common/format.hpp"
 #include "common/haptics/csv_tables.hpp"
 #include "common/input_error.hpp"
 
@@ -28,23 +28,17 @@ const std::vector<std::string> kToolHeader{
 const std::vector<std::string> kStampHeader{"stamp",       "t",     "x",     "y",   "bottom_z",
                                             "heading_rad", "dir_x", "dir_y", "tool"};
 
-std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 // A tool's row without its index.
 std::string tool_fields(const ToolSpec& t) {
   std::string poly;
   for (const Vec2& p : t.polygon_m) {
     if (!poly.empty()) poly += ' ';
-    poly.append(num(p.x())).append(" ").append(num(p.y()));
+    poly.append(exact_number(p.x())).append(" ").append(exact_number(p.y()));
   }
-  return to_string(t.shape) + "," + num(t.radius_m) + "," + num(2.0 * t.half_size_m.x()) + "," +
-         num(2.0 * t.half_size_m.y()) + "," + std::to_string(t.sides) + "," + to_string(t.profile) + "," +
-         num(t.sphere_radius_m) + "," + num(t.depth_m) + "," + num(t.rim.width_m) + "," + num(t.rim.forward_bias) +
-         "," + num(t.pour_volume_m3) + "," + poly;
+  return to_string(t.shape) + "," + exact_number(t.radius_m) + "," + exact_number(2.0 * t.half_size_m.x()) + "," +
+         exact_number(2.0 * t.half_size_m.y()) + "," + std::to_string(t.sides) + "," + to_string(t.profile) + "," +
+         exact_number(t.sphere_radius_m) + "," + exact_number(t.depth_m) + "," + exact_number(t.rim.width_m) + "," +
+         exact_number(t.rim.forward_bias) + "," + exact_number(t.pour_volume_m3) + "," + poly;
 }
 
 std::string join(const std::vector<std::string>& v) {
@@ -53,48 +47,25 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
+// A tool's row; the fields are checked by ToolSpec::problem(), as for every tool.
 ToolSpec read_tool(const CsvFile& f, const CsvTable& t, std::size_t r) {
   ToolSpec tool;
-  const std::string& shape = t.rows[r][1];
   const int line = t.lines[r];
-  if (shape == "disk")
-    tool.shape = ToolShape::Disk;
-  else if (shape == "box")
-    tool.shape = ToolShape::Box;
-  else if (shape == "ellipse")
-    tool.shape = ToolShape::Ellipse;
-  else if (shape == "polygon")
-    tool.shape = ToolShape::Polygon;
-  else if (shape == "pour")
-    tool.shape = ToolShape::Pour;
-  else
-    csv_fail(f, line, "column shape = '" + shape + "' must be disk | box | ellipse | polygon | pour");
-  auto positive = [&](std::size_t col) {
-    const double v = csv_number(f, t, r, col);
-    if (!(v > 0.0)) csv_fail(f, line, "column " + t.header[col] + " = " + t.rows[r][col] + " must be > 0");
-    return v;
-  };
-  tool.radius_m = positive(2);
-  tool.half_size_m = Vec2(positive(3), positive(4)) / 2.0;
+  const auto shape = tool_shape_from(t.rows[r][1]);
+  if (!shape) csv_fail(f, line, "column shape = '" + t.rows[r][1] + "' must be disk | box | ellipse | polygon | pour");
+  tool.shape = *shape;
+  tool.radius_m = csv_number(f, t, r, 2);
+  tool.half_size_m = Vec2(csv_number(f, t, r, 3), csv_number(f, t, r, 4)) / 2.0;
   const std::size_t sides = csv_index(f, t, r, 5);
-  if (sides < 3 || sides > 4096) csv_fail(f, line, "column sides = " + t.rows[r][5] + " must be in [3, 4096]");
-  tool.sides = static_cast<int>(sides);
-  const std::string& profile = t.rows[r][6];
-  if (profile == "flat")
-    tool.profile = BottomProfile::Flat;
-  else if (profile == "sphere_cap")
-    tool.profile = BottomProfile::SphereCap;
-  else
-    csv_fail(f, line, "column profile = '" + profile + "' must be flat | sphere_cap");
-  tool.sphere_radius_m = positive(7);
+  tool.sides = static_cast<int>(std::min<std::size_t>(sides, 1u << 30));
+  const auto profile = bottom_profile_from(t.rows[r][6]);
+  if (!profile) csv_fail(f, line, "column profile = '" + t.rows[r][6] + "' must be flat | sphere_cap");
+  tool.profile = *profile;
+  tool.sphere_radius_m = csv_number(f, t, r, 7);
   tool.depth_m = csv_number(f, t, r, 8);
   tool.rim.width_m = csv_number(f, t, r, 9);
   tool.rim.forward_bias = csv_number(f, t, r, 10);
-  if (tool.rim.width_m < 0.0 || tool.rim.forward_bias < 0.0 || tool.rim.forward_bias > 1.0)
-    csv_fail(f, line, "columns rim_width_m >= 0 and rim_forward_bias in [0, 1] required");
   tool.pour_volume_m3 = csv_number(f, t, r, 11);
-  if (tool.shape == ToolShape::Pour && !(tool.pour_volume_m3 > 0.0))
-    csv_fail(f, line, "column pour_volume_m3 must be > 0 for a pour tool");
   std::istringstream poly(t.rows[r][12]);
   std::vector<double> xy;
   for (std::string w; poly >> w;) {
@@ -105,8 +76,7 @@ ToolSpec read_tool(const CsvFile& f, const CsvTable& t, std::size_t r) {
   }
   if (xy.size() % 2 != 0) csv_fail(f, line, "column polygon_m must hold x y pairs");
   for (std::size_t i = 0; i < xy.size(); i += 2) tool.polygon_m.emplace_back(xy[i], xy[i + 1]);
-  if (tool.shape == ToolShape::Polygon && (tool.polygon_m.size() < 3 || !is_simple_polygon(tool.polygon_m)))
-    csv_fail(f, line, "column polygon_m must be a simple polygon of at least 3 points");
+  if (const auto problem = tool.problem()) csv_fail(f, line, *problem);
   return tool;
 }
 
@@ -135,17 +105,18 @@ void write_session(const std::filesystem::path& file, const Session& s) {
     if (!s.forces.empty()) {
       out << join(kForceHeader) << "\n";
       for (const SessionForce& f : s.forces)
-        out << num(f.t_s) << "," << num(f.force_n.x()) << "," << num(f.force_n.y()) << "," << num(f.force_n.z()) << ","
-            << num(f.penetration_m) << "\n";
+        out << exact_number(f.t_s) << "," << exact_number(f.force_n.x()) << "," << exact_number(f.force_n.y()) << ","
+            << exact_number(f.force_n.z()) << "," << exact_number(f.penetration_m) << "\n";
     }
     out << join(kToolHeader) << "\n";
     for (std::size_t i = 0; i < s.tools.size(); ++i) out << i << "," << tool_fields(s.tools[i]) << "\n";
     out << join(kStampHeader) << "\n";
     for (std::size_t i = 0; i < s.stamps.size(); ++i) {
       const SessionStamp& st = s.stamps[i];
-      out << i << "," << num(st.t_s) << "," << num(st.pose.xy.x()) << "," << num(st.pose.xy.y()) << ","
-          << num(st.pose.bottom_z) << "," << num(st.pose.heading_rad) << "," << num(st.motion_dir.x()) << ","
-          << num(st.motion_dir.y()) << "," << st.tool << "\n";
+      out << i << "," << exact_number(st.t_s) << "," << exact_number(st.pose.xy.x()) << ","
+          << exact_number(st.pose.xy.y()) << "," << exact_number(st.pose.bottom_z) << ","
+          << exact_number(st.pose.heading_rad) << "," << exact_number(st.motion_dir.x()) << ","
+          << exact_number(st.motion_dir.y()) << "," << st.tool << "\n";
     }
     out.flush();
     if (!out) throw std::runtime_error("writing " + tmp.string() + " failed");
@@ -228,15 +199,16 @@ namespace {
 // A session tool as scene overrides: the keys the scene format has for its shape.
 std::vector<std::string> tool_overrides(const ToolSpec& t) {
   std::vector<std::string> o{unset_override("tool"), "tool.shape=\"" + to_string(t.shape) + "\""};
-  const std::string size = "tool.size_m=[" + num(2.0 * t.half_size_m.x()) + "," + num(2.0 * t.half_size_m.y()) + "]";
+  const std::string size =
+      "tool.size_m=[" + exact_number(2.0 * t.half_size_m.x()) + "," + exact_number(2.0 * t.half_size_m.y()) + "]";
   switch (t.shape) {
     case ToolShape::Disk:
-      o.push_back("tool.radius_m=" + num(t.radius_m));
+      o.push_back("tool.radius_m=" + exact_number(t.radius_m));
       o.push_back("tool.sides=" + std::to_string(t.sides));
       break;
     case ToolShape::Pour:
-      o.push_back("tool.radius_m=" + num(t.radius_m));
-      o.push_back("tool.volume_m3=" + num(t.pour_volume_m3));
+      o.push_back("tool.radius_m=" + exact_number(t.radius_m));
+      o.push_back("tool.volume_m3=" + exact_number(t.pour_volume_m3));
       return o;
     case ToolShape::Box:
       o.push_back(size);
@@ -249,32 +221,20 @@ std::vector<std::string> tool_overrides(const ToolSpec& t) {
       std::string poly;
       for (const Vec2& p : t.polygon_m) {
         if (!poly.empty()) poly.push_back(',');
-        poly.append("[").append(num(p.x())).append(",").append(num(p.y())).append("]");
+        poly.append("[").append(exact_number(p.x())).append(",").append(exact_number(p.y())).append("]");
       }
       o.push_back("tool.polygon_m=[" + poly + "]");
       break;
     }
   }
-  o.push_back("tool.depth_m=" + num(t.depth_m));
+  o.push_back("tool.depth_m=" + exact_number(t.depth_m));
   o.push_back("tool.profile=\"" + to_string(t.profile) + "\"");
-  if (t.profile == BottomProfile::SphereCap) o.push_back("tool.sphere_radius_m=" + num(t.sphere_radius_m));
-  o.push_back("tool.rim_width_m=" + num(t.rim.width_m));
-  o.push_back("tool.rim_forward_bias=" + num(t.rim.forward_bias));
+  if (t.profile == BottomProfile::SphereCap) o.push_back("tool.sphere_radius_m=" + exact_number(t.sphere_radius_m));
+  o.push_back("tool.rim_width_m=" + exact_number(t.rim.width_m));
+  o.push_back("tool.rim_forward_bias=" + exact_number(t.rim.forward_bias));
   return o;
 }
 
-double footprint_corners(const ToolSpec& t) {
-  switch (t.shape) {
-    case ToolShape::Box:
-      return 4.0;
-    case ToolShape::Polygon:
-      return static_cast<double>(t.polygon_m.size());
-    case ToolShape::Pour:
-      return 1.0;
-    default:
-      return static_cast<double>(t.sides);
-  }
-}
 }  // namespace
 
 void validate_session(const Session& session, const Scene& scene, const std::string& option) {
@@ -290,11 +250,12 @@ void validate_session(const Session& session, const Scene& scene, const std::str
     }
   }
   double corners = 0.0;
-  for (const SessionStamp& st : session.stamps) corners += footprint_corners(session.tools[st.tool]);
+  for (const SessionStamp& st : session.stamps)
+    corners += static_cast<double>(session.tools[st.tool].footprint_corners());
   if (corners > kMaxStampCorners)
     throw InputError(option + ": the session's " + std::to_string(session.stamps.size()) + " stamps have " +
-                     num(corners) + " footprint corners in all, more than a scene may ask for (" +
-                     num(kMaxStampCorners) + ")");
+                     exact_number(corners) + " footprint corners in all, more than a scene may ask for (" +
+                     exact_number(kMaxStampCorners) + ")");
 }
 
 StampSchedule session_schedule(const Session& session) {

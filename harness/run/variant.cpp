@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 
 #include "common/input_error.hpp"
@@ -38,12 +39,9 @@ Variant parse_variant(const std::string& text, const std::string& option) {
   const std::size_t colon = text.find(':');
   v.backend = text.substr(0, colon);
   const auto names = backend_names();
-  if (std::find(names.begin(), names.end(), v.backend) == names.end()) {
-    std::string list;
-    for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
-    throw InputError(option + ": \"" + v.backend + "\" is not a back-end; must be one of " + list +
+  if (std::find(names.begin(), names.end(), v.backend) == names.end())
+    throw InputError(option + ": \"" + v.backend + "\" is not a back-end; must be one of " + backend_list(", ") +
                      ", optionally followed by :key=value overrides (e.g. grid:grid.storage=float)");
-  }
   if (colon == std::string::npos) return v;
   start = colon + 1;
   while (start <= text.size()) {
