@@ -5,6 +5,19 @@
 
 namespace sb::grid {
 
+namespace {
+
+// Central differences (one-sided on the border): the gradient rule's input. O(1).
+template <class Real>
+SurfaceGradient grid_gradient(const HeightGrid<Real>& grid, const GridLayout& layout, std::size_t ix, std::size_t iy) {
+  const std::size_t x0 = ix > 0 ? ix - 1 : ix, x1 = ix + 1 < layout.nx ? ix + 1 : ix;
+  const std::size_t y0 = iy > 0 ? iy - 1 : iy, y1 = iy + 1 < layout.ny ? iy + 1 : iy;
+  return {(grid.z(layout.index(x1, iy)) - grid.z(layout.index(x0, iy))) / (static_cast<double>(x1 - x0) * layout.dx),
+          (grid.z(layout.index(ix, y1)) - grid.z(layout.index(ix, y0))) / (static_cast<double>(y1 - y0) * layout.dy)};
+}
+
+}  // namespace
+
 template <class Real>
 ErosionReport erode_grid(HeightGrid<Real>& grid, ActiveSet& active, const Stencil& stencil, const ErosionRule& rule,
                          const ErosionBudget& budget) {
@@ -29,13 +42,16 @@ ErosionReport erode_grid(HeightGrid<Real>& grid, ActiveSet& active, const Stenci
       std::size_t n = 0;
       stencil.for_each(layout, ix, iy, [&](std::size_t jx, std::size_t jy, int slot) {
         const std::uint32_t j = layout.index(jx, jy);
-        nbrs[n] = {grid.z(j), stencil.distance_m[slot], layout.area(jx, jy)};
+        nbrs[n] = {grid.z(j), stencil.distance_m[slot], layout.area(jx, jy), stencil.ox[slot] * layout.dx,
+                   stencil.oy[slot] * layout.dy};
         nbr_node[n] = j;
         ++n;
       });
       const double z_i = grid.z(k);
       const double area_i = layout.area(ix, iy);
-      const double total = erosion_transfers(z_i, area_i, std::span(nbrs.data(), n), rule, std::span(sent.data(), n));
+      const SurfaceGradient gradient = rule.needs_gradient() ? grid_gradient(grid, layout, ix, iy) : SurfaceGradient{};
+      const double total =
+          erosion_transfers(z_i, area_i, gradient, std::span(nbrs.data(), n), rule, std::span(sent.data(), n));
       if (total <= 0.0) {
         active.idle(k);
         continue;

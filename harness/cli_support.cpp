@@ -53,7 +53,7 @@ VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_pr
   }
   PreparedScene prepared = base;
   prepared.scene = scene;
-  prepared.rule = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg);
+  prepared.rule = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg, scene.erosion.rule);
 
   auto terrain = make_terrain(v.backend, prepared.scene, prepared.initial);
   VariantRun out{

@@ -8,7 +8,7 @@ PreparedScene prepare_scene(Scene scene) {
   PreparedScene p{std::move(scene), {}, {}, {}, {}};
   p.initial = HeightField::from_scene(p.scene);
   p.schedule = make_schedule(p.scene.tool, p.scene.stroke, [&](const Vec2& q) { return p.initial(q); });
-  p.rule = ErosionRule::from(p.scene.material, p.scene.erosion.settle_tolerance_deg);
+  p.rule = ErosionRule::from(p.scene.material, p.scene.erosion.settle_tolerance_deg, p.scene.erosion.rule);
   p.raster_template = Raster::covering(p.scene.domain.box(), p.scene.output.raster_m);
   return p;
 }

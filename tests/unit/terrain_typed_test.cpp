@@ -112,7 +112,9 @@ class TerrainTyped : public ::testing::Test {
     const HeightField field = HeightField::from_scene(s);
     return make_schedule(s.tool, s.stroke, [&field](const Vec2& p) { return field(p); });
   }
-  static ErosionRule rule(const Scene& s) { return ErosionRule::from(s.material, s.erosion.settle_tolerance_deg); }
+  static ErosionRule rule(const Scene& s) {
+    return ErosionRule::from(s.material, s.erosion.settle_tolerance_deg, s.erosion.rule);
+  }
   static void expect_ok(const Terrain& t, const char* when) {
     const IntegrityReport r = t.check();
     EXPECT_TRUE(r.ok()) << when << ": " << ::testing::PrintToString(r.problems);
