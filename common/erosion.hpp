@@ -1,5 +1,5 @@
 #pragma once
-// The one erosion rule of DESIGN.md, stated once for every back-end, in two variants.
+// The one erosion rule (README "Architecture"), stated once for every back-end, in two variants.
 //
 // Between a centre i and a neighbour j, material moves from the higher to the lower when the
 // drop z_i - z_j exceeds the drop the critical slope allows over a run r_j:

@@ -64,7 +64,7 @@ struct PlaneShape {
 };
 PlaneShape measure_plane(const Raster& heights);
 
-// The accuracy metrics of DESIGN.md for the scene's reference, as summary entries
+// The accuracy metrics (README "Summary metrics") for the scene's reference, as summary entries
 // ("reference.rmse_m", "pile.flank_angle_deg", ...). Empty when the scene has none.
 nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule& schedule, const HeightField& initial,
                                         const Raster& initial_raster, const Raster& final_raster);

@@ -297,11 +297,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   // [tool]
   const std::string shape = f.choice("tool.shape", "disk", {"disk", "box", "ellipse", "polygon", "pour"});
   ToolSpec& t = s.tool;
-  t.shape = shape == "disk"      ? ToolShape::Disk
-            : shape == "box"     ? ToolShape::Box
-            : shape == "ellipse" ? ToolShape::Ellipse
-            : shape == "polygon" ? ToolShape::Polygon
-                                 : ToolShape::Pour;
+  t.shape = *tool_shape_from(shape);
   const Range tool_size = positive(extent * 10.0);
   if (t.shape == ToolShape::Disk || t.shape == ToolShape::Pour) t.radius_m = f.number("tool.radius_m", 0.02, tool_size);
   if (t.shape == ToolShape::Box || t.shape == ToolShape::Ellipse) {
@@ -320,7 +316,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   } else {
     t.depth_m = f.number("tool.depth_m", 0.01, open(-1e6, 1e6));
     const std::string profile = f.choice("tool.profile", "flat", {"flat", "sphere_cap"});
-    t.profile = profile == "flat" ? BottomProfile::Flat : BottomProfile::SphereCap;
+    t.profile = *bottom_profile_from(profile);
     if (t.profile == BottomProfile::SphereCap) t.sphere_radius_m = f.number("tool.sphere_radius_m", 0.05, tool_size);
     t.rim.width_m = f.number("tool.rim_width_m",
                              0.5 * (t.shape == ToolShape::Disk ? t.radius_m : t.half_size_m.minCoeff()), tool_size);
@@ -342,13 +338,15 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   // [tin]
   s.tin.alpha_flat_deg = f.number("tin.alpha_flat_deg", 0.4, closed(0.0, 45.0));
   s.tin.tolerance_m = f.number("tin.tolerance_m", 0.001, positive(1e6));
-  s.tin.conserve_volume = f.boolean("tin.conserve_volume", false);
+  s.tin.conserve_volume = f.boolean("tin.conserve_volume", true);
   s.tin.contour_subdivision_m = f.number("tin.contour_subdivision_m", 0.0, closed(0.0, extent));
   s.tin.snap_m = f.number("tin.snap_m", 1e-6, closed(0.0, 1e-2));
   s.tin.initial_points = f.integer("tin.initial_points", 0, 0, 20000000);
   s.tin.initial_jitter = f.number("tin.initial_jitter", 0.5, closed(0.0, 0.9));
   s.tin.contour_gap_m = f.number("tin.contour_gap_m", 0.0, closed(0.0, extent));
   s.tin.refine_m = f.number("tin.refine_m", 0.0, closed(0.0, extent));
+  s.tin.planar_tolerance_m = f.number("tin.planar_tolerance_m", 0.0, closed(0.0, 1e6));
+  s.tin.coarsen = f.boolean("tin.coarsen", false);
 
   // [grid]
   s.grid.cell_m = f.number("grid.cell_m", 0.005, positive(extent));
@@ -383,6 +381,19 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   const double samples = (s.domain.size_m.x() / s.output.raster_m + 1) * (s.domain.size_m.y() / s.output.raster_m + 1);
   if (samples > 1e8) Fields::fail("output.raster_m", "gives more than 1e8 raster samples for this domain");
   s.output.energy = f.boolean("output.energy", false);
+
+  // [haptics] (common/haptics/rendering.hpp; only `sandbench interactive` uses them)
+  haptics::RenderingOptions& h = s.haptics;
+  h.blend_s = 1e-3 * f.number("haptics.blend_ms", 1e3 * h.blend_s, closed(0.0, 1000.0));
+  h.max_force_rate_n_per_s = f.number("haptics.max_force_rate_n_per_s", h.max_force_rate_n_per_s, closed(0.0, 1e6));
+  h.passivity = f.boolean("haptics.passivity_control", h.passivity);
+  h.passivity_max_force_n = f.number("haptics.passivity_max_force_n", h.passivity_max_force_n, closed(0.0, 1e3));
+  h.coupling = f.boolean("haptics.coupling", h.coupling);
+  h.coupling_stiffness_n_per_m =
+      f.number("haptics.coupling_stiffness_n_per_m", h.coupling_stiffness_n_per_m, positive(1e6));
+  h.coupling_damping_n_s_per_m =
+      f.number("haptics.coupling_damping_n_s_per_m", h.coupling_damping_n_s_per_m, closed(0.0, 1e4));
+  h.tool_mass_kg = f.number("haptics.tool_mass_kg", h.tool_mass_kg, positive(100.0));
 }
 
 }  // namespace

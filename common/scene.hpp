@@ -8,6 +8,7 @@
 
 #include "common/erosion.hpp"
 #include "common/geometry.hpp"
+#include "common/haptics/rendering.hpp"
 #include "common/material.hpp"
 #include "common/schedule.hpp"
 #include "common/tool.hpp"
@@ -55,7 +56,7 @@ struct ErosionSpec {
 struct TinSpec {
   double alpha_flat_deg = 0.4;         // the paper's alpha_flat, read as degrees
   double tolerance_m = 0.001;          // greedy insertion: max height error of the initial TIN
-  bool conserve_volume = false;        // compensate simplification and flip volume changes
+  bool conserve_volume = true;         // compensate retriangulation volume changes; false: the paper
   double contour_subdivision_m = 0.0;  // outer contour subdivision step; 0: tool polygon only
   double snap_m = 1e-6;                // points closer than this to a vertex reuse it
   // A TIN of about this many vertices from the start (a jittered lattice with heights from
@@ -64,7 +65,13 @@ struct TinSpec {
   double initial_jitter = 0.5;  // lattice jitter, fraction of a cell; 0: exact lattice
   double contour_gap_m = 0.0;   // outer-to-inner contour distance; 0: 5% of the tool size
   double refine_m = 0.0;        // erosion splits edges longer than this that sand flows
-                                // across; 0: half the tool (or pour) radius
+                                // across; 0: 4 tolerance_m / tan(critical angle)
+  // coarsen: simplification also removes settled vertices within planar_tolerance_m of the
+  // plane fitted to their neighbours (volume-preserving; 0: tolerance_m / 4). Off by default:
+  // with the edge-wise erosion rule the coarser mesh settles with triangles up to a few
+  // degrees steeper than critical. Off keeps the paper's step 3 alone (alpha_flat_deg).
+  double planar_tolerance_m = 0.0;
+  bool coarsen = false;
 };
 
 enum class GridStorage { Float, Double };
@@ -100,6 +107,7 @@ struct Scene {
   TinSpec tin;
   GridSpec grid;
   OutputSpec output;
+  haptics::RenderingOptions haptics;  // [haptics]: how the interactive servo renders forces
   ReferenceKind reference = ReferenceKind::None;
 };
 

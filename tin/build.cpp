@@ -7,6 +7,7 @@
 #include <numbers>
 #include <queue>
 
+#include "common/erosion.hpp"
 #include "common/input_error.hpp"
 #include "common/point_sets.hpp"
 #include "tin/detail/tin_impl.hpp"
@@ -34,6 +35,18 @@ double tool_radius(const ToolSpec& t) {
 
 }  // namespace
 
+double default_refine_m(const Scene& scene) {
+  // Linear interpolation over an edge of length h across a slope break of tan(critical)
+  // (a pile's toe and apex, a wall's foot) errs by at most h tan / 4: the edge length at
+  // which the surface stays within tin.tolerance_m. Never finer than half the tool's radius
+  // (what a stamp resolves anyway; finer, erosion over a whole dune field refines it all),
+  // never coarser than 5 % of the domain.
+  const double extent = std::max(scene.domain.size_m.x(), scene.domain.size_m.y());
+  const double tan_c = scene.material.tan_critical();
+  const double h = tan_c > 0.0 ? 4.0 * scene.tin.tolerance_m / tan_c : extent;
+  return std::min(std::max(h, 0.5 * tool_radius(scene.tool)), 0.05 * extent);
+}
+
 TinTerrain::TinTerrain(const Scene& scene)
     : domain_(scene.domain), box_(scene.domain.box()), spec_(scene.tin), idle_passes_(scene.erosion.idle_passes) {
   const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
@@ -41,9 +54,14 @@ TinTerrain::TinTerrain(const Scene& scene)
     throw InputError("scene: domain.size_m must be positive and finite for the TIN");
   tool_size_m_ = tool_radius(scene.tool);
   if (!(tool_size_m_ > 0.0) || !std::isfinite(tool_size_m_)) tool_size_m_ = 0.02 * extent;
-  refine_m_ = spec_.refine_m > 0.0 ? spec_.refine_m : 0.5 * tool_size_m_;
-  // Never split below what snapping could merge again.
-  refine_m_ = std::max(refine_m_, std::max(64.0 * spec_.snap_m, 1e-7 * extent));
+  refine_m_ = spec_.refine_m > 0.0 ? spec_.refine_m : default_refine_m(scene);
+  // Never split below what snapping could merge again, nor below a ten-thousandth of the
+  // domain (a 0.4 mm tool must not refine a 30 cm domain to 0.1 mm).
+  refine_m_ = std::max(refine_m_, std::max(64.0 * spec_.snap_m, 1e-4 * extent));
+  // A thousandth of the TIN's accuracy: what coarsening may add to an edge's height drop.
+  settle_dz_ = 1e-3 * spec_.tolerance_m;
+  tan_critical_ = scene.material.tan_critical();
+  tan_settle_ = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg).tan_settle;
   kind_ = scene.terrain.kind;
   base_height_m_ = scene.terrain.height_m;
 }
@@ -63,9 +81,11 @@ void TinTerrain::finish_build() {
   for (auto f = cdt_.all_faces_begin(); f != cdt_.all_faces_end(); ++f) f->info() = 0;
   face_epoch_ = 0;
   vertex_epoch_ = 0;
+  hull_vertices_ = 0;
   for (auto v = cdt_.finite_vertices_begin(); v != cdt_.finite_vertices_end(); ++v) {
     v->info() = VertexInfo{};
     v->info().border = on_border(xy(v->point())) ? 1 : 0;
+    hull_vertices_ += v->info().border;
   }
   hint_ = cdt_.finite_vertices_begin();
 }

@@ -3,6 +3,7 @@
 // that exchange sand first get edges no longer than refine_m_ (long edges are split at their
 // middle): a pile poured on a coarse TIN can only spread if the mesh refines where the sand
 // goes, and sand on a vertex with far-reaching triangles would be spread thinly over them.
+#include <algorithm>
 #include <cmath>
 
 #include "common/input_error.hpp"
@@ -32,7 +33,8 @@ VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* insert
   const VertexHandle v = insert_point(m, height(m), inserted);
   const CaptureResult measured = end_capture(capture);
   if (!*inserted) return v;
-  // The split itself keeps the surface; the Delaunay flips after it may not.
+  // The split itself keeps the surface; the Delaunay flips after it may not: their volume
+  // change is given back to the new vertex (tin.conserve_volume, the default).
   if (spec_.conserve_volume && measured.delta() != 0.0) {
     const double area = vertex_area(v);
     if (area > 0.0) set_z(v, v->point().z() - measured.delta() / area);
@@ -73,7 +75,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& bu
       rule.tan_critical < 0.0 || rule.fraction < 0.0)
     throw InputError("erosion: the rule's slopes and fraction must be finite and non-negative");
   ErosionReport report;
-  std::vector<VertexHandle> work;
+  std::vector<VertexHandle>& work = work_scratch_;
   // The gradient rule's input: the area-weighted facet gradients of v's star (gather_neighbours
   // lists the neighbours counter-clockwise, so consecutive ones span v's triangles).
   const auto gradient_at = [&](VertexHandle v) {
@@ -101,21 +103,33 @@ ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& bu
         transfer_scratch_.resize(nbr_scratch_.size());
         total = erosion_transfers(v->point().z(), area, gradient_at(v), nbr_scratch_, rule, transfer_scratch_);
       }
+      // Settling criterion (slope excess): the rule moves nothing where every slope is below
+      // tan_settle (erosion.settle_tolerance_deg above critical); a transfer removes a fixed
+      // fraction of the excess, so each slope settles in O(log(excess / tolerance)) visits,
+      // and with the mesh refined no finer than refine_m_ the work is bounded.
       if (total > 0.0 && area > 0.0) {
         set_z(v, v->point().z() - total / area);
+        // One ring: v fell, so its neighbours' drops towards v grew; a receiver rose, which
+        // only its own drops grow (its neighbours' drops towards it shrank).
         touch_with_neighbours(v);
         add_to_simplify(v);
         for (std::size_t k = 0; k < nbr_scratch_.size(); ++k) {
           if (transfer_scratch_[k] <= 0.0 || nbr_scratch_[k].area <= 0.0) continue;
           const VertexHandle w = vertex_scratch_[k];
           set_z(w, w->point().z() + transfer_scratch_[k] / nbr_scratch_[k].area);
-          touch_with_neighbours(w);
+          touch(w);
           add_to_simplify(w);
           ++report.transfers;
         }
         report.volume_moved_m3 += total;
       } else if (++v->info().idle >= idle_passes_) {
         drop_from_erosion(v);
+        // Settled: v and its neighbours (whose rings may now be all settled) are candidates
+        // for coarsening.
+        if (spec_.coarsen) {
+          add_to_simplify(v);
+          for (VertexHandle w : vertex_scratch_) add_to_simplify(w);
+        }
       }
     }
   }

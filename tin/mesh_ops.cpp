@@ -24,8 +24,10 @@ Location TinTerrain::locate(const Vec2& p) const {
   FaceHandle f = start_face();
   FaceHandle came_from;
   // A walk can only cycle in a non-Delaunay triangulation, and the random order breaks such
-  // cycles with probability 1; the cap is a guard, never expected to be reached.
-  const std::uint64_t cap = 64 + 4 * static_cast<std::uint64_t>(cdt_.number_of_faces());
+  // cycles with probability 1; the cap is a guard, never expected to be reached. The data
+  // structure's own face count (infinite faces included) is O(1); the triangulation's
+  // number_of_faces() circulates the whole convex hull, O(sqrt(n)) on a TIN with border points.
+  const std::uint64_t cap = 64 + 4 * static_cast<std::uint64_t>(cdt_.tds().number_of_faces());
   std::uint64_t steps = 0;
   bool walked_out = false;
   for (;;) {
@@ -175,6 +177,7 @@ VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted
   const VertexHandle v = cdt_.insert(Point(p.x(), p.y(), z), loc.type, loc.face, loc.index);
   v->info() = VertexInfo{};
   v->info().border = on_border(p) ? 1 : 0;
+  hull_vertices_ += v->info().border;
   // Every face the insertion (and its flips) changed is incident to v now.
   forget_star(v);
   if (splits_constraint) {

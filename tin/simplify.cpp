@@ -1,7 +1,17 @@
-// Simplification (the paper's step 3): a vertex of L_r is redundant when every edge to a
-// neighbour makes an angle with the horizontal plane below alpha_flat; border and constrained
-// vertices stay. Redundant vertices are removed by CGAL (Devillers' removal: the star is
-// retriangulated as a constrained Delaunay polygon).
+// Simplification (the paper's step 3, generalised). A vertex of L_r is redundant when
+//  - flat (the paper): every edge to a neighbour makes an angle with the horizontal plane
+//    below alpha_flat; or
+//  - planar (tin.coarsen, settled vertices only): the vertex and all its neighbours lie within
+//    tin.planar_tolerance_m of the least-squares plane of the neighbours, so any
+//    retriangulation of the hole stays within twice that of the surface it replaces, and no
+//    edge the retriangulation may create is steeper than the critical angle (so coarsening
+//    never sets sand moving, and erosion never refines again what was just coarsened).
+// Border and constrained vertices stay. Redundant vertices are removed by CGAL (Devillers'
+// removal: the star is retriangulated as a constrained Delaunay polygon); the volume change of
+// the retriangulation is measured over the hole and given back to the hole's vertices
+// (tin.conserve_volume, the default), so removal conserves volume. Vertices whose ring is still in L_e rejoin L_r when
+// it settles.
+#include <algorithm>
 #include <cmath>
 
 #include "common/input_error.hpp"
@@ -12,8 +22,22 @@ namespace sb::tin::detail {
 
 namespace {
 
+bool is_removable(const Cdt& cdt, VertexHandle v) {
+  return !v->info().border && !cdt.are_there_incident_constraints(v);
+}
+
+// v and its neighbours have left L_e: no sand flows here, so erosion will not refine the
+// region again right after the removal (which would make the two churn).
+bool is_settled(const Cdt& cdt, VertexHandle v) {
+  if (v->info().erosion_slot != kNoSlot) return false;
+  auto c = cdt.incident_vertices(v), done = c;
+  do {
+    if (!cdt.is_infinite(c) && c->info().erosion_slot != kNoSlot) return false;
+  } while (++c != done);
+  return true;
+}
+
 bool is_flat(const Cdt& cdt, VertexHandle v, double tan_alpha) {
-  if (v->info().border || cdt.are_there_incident_constraints(v)) return false;
   const Point& p = v->point();
   auto c = cdt.incident_vertices(v), done = c;
   do {
@@ -25,7 +49,71 @@ bool is_flat(const Cdt& cdt, VertexHandle v, double tan_alpha) {
   return true;
 }
 
+// Least-squares plane z = a + b x + c y of v's neighbours (coordinates relative to v), then
+// whether its gradient is at most max_gradient and v and every neighbour lie within `tol` of
+// it. O(degree), no allocation.
+bool is_planar(const Cdt& cdt, VertexHandle v, double tol, double max_gradient) {
+  const Point& p = v->point();
+  double n = 0, sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, syy = 0, sxz = 0, syz = 0;
+  auto c = cdt.incident_vertices(v), done = c;
+  do {
+    if (cdt.is_infinite(c)) return false;
+    const double x = c->point().x() - p.x(), y = c->point().y() - p.y(), z = c->point().z() - p.z();
+    n += 1;
+    sx += x, sy += y, sz += z, sxx += x * x, sxy += x * y, syy += y * y, sxz += x * z, syz += y * z;
+  } while (++c != done);
+  // Centred normal equations for the slopes, then the intercept.
+  const double mx = sx / n, my = sy / n, mz = sz / n;
+  const double cxx = sxx - n * mx * mx, cxy = sxy - n * mx * my, cyy = syy - n * my * my;
+  const double cxz = sxz - n * mx * mz, cyz = syz - n * my * mz;
+  const double det = cxx * cyy - cxy * cxy;
+  if (!(det > 1e-12 * (cxx * cyy)) || !(det > 0.0)) return false;
+  const double b = (cxz * cyy - cyz * cxy) / det, g = (cyz * cxx - cxz * cxy) / det;
+  if (!(std::hypot(b, g) <= max_gradient)) return false;
+  const double a = mz - b * mx - g * my;
+  if (!(std::abs(a) <= tol)) return false;  // v itself (at the origin, z = 0)
+  c = done;
+  do {
+    const double x = c->point().x() - p.x(), y = c->point().y() - p.y(), z = c->point().z() - p.z();
+    if (!(std::abs(z - (a + b * x + g * y)) <= tol)) return false;
+  } while (++c != done);
+  return true;
+}
+
+// Whether every edge the removal could create (between two of v's neighbours) is stable:
+// no pair of neighbours lies more than `slack` beyond the critical slope apart. Coarsening
+// then never sets sand moving, so erosion does not refine again what was just coarsened.
+// O(degree^2), degree about 6.
+bool removal_keeps_stable(const Cdt& cdt, VertexHandle v, double tan_critical, double slack) {
+  auto a = cdt.incident_vertices(v), done = a;
+  do {
+    auto b = a;
+    for (++b; b != done; ++b) {
+      const Point &p = a->point(), &q = b->point();
+      const double d = std::hypot(q.x() - p.x(), q.y() - p.y());
+      if (std::abs(q.z() - p.z()) - d * tan_critical >= slack) return false;
+    }
+  } while (++a != done);
+  return true;
+}
+
 }  // namespace
+
+bool TinTerrain::hole_is_steep(const std::vector<VertexHandle>& link) const {
+  auto in_link = [&link](VertexHandle w) { return std::find(link.begin(), link.end(), w) != link.end(); };
+  for (VertexHandle w : link) {
+    auto f = cdt_.incident_faces(w), done = f;
+    do {
+      if (cdt_.is_infinite(f) || !in_link(f->vertex(0)) || !in_link(f->vertex(1)) || !in_link(f->vertex(2))) continue;
+      const Point &a = f->vertex(0)->point(), &b = f->vertex(1)->point(), &c = f->vertex(2)->point();
+      const double ux = b.x() - a.x(), uy = b.y() - a.y(), uz = b.z() - a.z();
+      const double vx = c.x() - a.x(), vy = c.y() - a.y(), vz = c.z() - a.z();
+      const double nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+      if (std::hypot(nx, ny) > tan_settle_ * std::abs(nz)) return true;
+    } while (++f != done);
+  }
+  return false;
+}
 
 SimplifyReport TinTerrain::simplify(const SimplifyParams& params) {
   if (!std::isfinite(params.alpha_flat_deg) || params.alpha_flat_deg < 0.0 || params.alpha_flat_deg >= 90.0)
@@ -33,45 +121,63 @@ SimplifyReport TinTerrain::simplify(const SimplifyParams& params) {
   SimplifyReport report;
   const double tan_alpha = std::tan(deg_to_rad(params.alpha_flat_deg));
   const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
+  const bool coarsen = spec_.coarsen;
+  const double planar_tol = spec_.planar_tolerance_m > 0.0 ? spec_.planar_tolerance_m : 0.25 * spec_.tolerance_m;
+  // Planes steeper than this are left alone: a flank at the angle of repose would, once
+  // coarsened, have triangles steeper than their (stable) edges.
+  const double max_gradient = 0.8 * tan_critical_;
+  auto redundant_now = [&](VertexHandle v) {
+    if (!is_removable(cdt_, v)) return false;
+    if (is_flat(cdt_, v, tan_alpha)) return true;
+    return coarsen && is_settled(cdt_, v) && is_planar(cdt_, v, planar_tol, max_gradient) &&
+           removal_keeps_stable(cdt_, v, tan_critical_, settle_dz_);
+  };
 
   Stopwatch watch;
   report.candidates = simplify_list_.size();
-  std::vector<VertexHandle> redundant;
+  std::vector<VertexHandle>& redundant = redundant_scratch_;
+  redundant.clear();
+  // A vertex that is not yet settled comes back to L_r when erosion lets it (or a
+  // neighbour) go (erosion.cpp), so L_r need not carry it meanwhile.
   for (VertexHandle v : simplify_list_) {
     v->info().simplify_slot = kNoSlot;
-    if (is_flat(cdt_, v, tan_alpha)) redundant.push_back(v);
+    if (redundant_now(v)) redundant.push_back(v);
   }
   simplify_list_.clear();
   report.detect_s = watch.seconds();
 
   watch.restart();
-  std::vector<VertexHandle> link;
+  std::vector<VertexHandle>& link = link_hold_scratch_;
   for (VertexHandle v : redundant) {
     // An earlier removal changed v's neighbours: check again (O(degree)).
-    if (!is_flat(cdt_, v, tan_alpha)) continue;
+    if (!redundant_now(v)) continue;
     link.clear();
     auto c = cdt_.incident_vertices(v), done = c;
     do {
       link.push_back(c);
     } while (++c != done);
     const Vec2 p = xy(v);
-    if (spec_.conserve_volume) {
-      // Removing a vertex that is not exactly planar with its star changes the volume:
-      // measured over the hole and spread back over the hole's vertices by area.
-      Capture capture = begin_capture(Aabb2{p, p}.expanded(4.0 * spec_.snap_m + 1e-9 * extent));
-      remove_vertex(v);
-      const CaptureResult measured = end_capture(capture);
-      double link_area = 0.0;
-      for (VertexHandle w : link) link_area += vertex_area(w);
-      if (measured.delta() != 0.0 && link_area > 0.0) {
-        const double dz = -measured.delta() / link_area;
-        for (VertexHandle w : link) set_z(w, w->point().z() + dz);
-      }
-    } else {
-      remove_vertex(v);
+    // Removing a vertex that is not exactly planar with its star changes the volume:
+    // measured over the hole and spread back over the hole's vertices by area.
+    Capture capture = begin_capture(Aabb2{p, p}.expanded(4.0 * spec_.snap_m + 1e-9 * extent));
+    const double z_before = v->point().z();
+    remove_vertex(v);
+    if (hole_is_steep(link)) {
+      // Triangles can be steeper than all their edges: put the vertex back (the same point
+      // gives back the same Delaunay triangulation, so the surface is restored).
+      insert_point(p, z_before);
+      end_capture(capture);
+      continue;
+    }
+    const CaptureResult measured = end_capture(capture);
+    double link_area = 0.0;
+    for (VertexHandle w : link) link_area += cached_area(w);
+    if (spec_.conserve_volume && measured.delta() != 0.0 && link_area > 0.0) {
+      const double dz = -measured.delta() / link_area;
+      for (VertexHandle w : link) set_z(w, w->point().z() + dz);
     }
     ++report.removed;
-    // The hole's vertices have new neighbours: they may now be unstable, or flat in turn.
+    // The hole's vertices have new neighbours: they may now be unstable, or redundant in turn.
     for (VertexHandle w : link) {
       touch(w);
       add_to_simplify(w);

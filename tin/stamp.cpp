@@ -117,7 +117,42 @@ bool same_border_side(const Vec2& a, const Vec2& b, const Aabb2& box) {
 
 }  // namespace
 
+double TinTerrain::drop_stale_constraints(std::uint32_t generation) {
+  std::vector<std::pair<VertexHandle, VertexHandle>> stale;
+  for (const auto& [key, g] : generations_) {
+    if (g >= generation) continue;
+    auto handle = [this](const void* p) {
+      return cdt_.tds().vertices().iterator_to(*static_cast<Tds::Vertex*>(const_cast<void*>(p)));
+    };
+    stale.emplace_back(handle(key.a), handle(key.b));
+  }
+  if (stale.empty()) return 0.0;
+  Aabb2 box{xy(stale.front().first), xy(stale.front().first)};
+  for (const auto& [a, b] : stale) box = unite(box, bounds(std::vector<Vec2>{xy(a), xy(b)}));
+  const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
+  Capture capture = begin_capture(box.expanded(4.0 * spec_.snap_m + 1e-9 * extent));
+  for (const auto& [a, b] : stale) unconstrain(a, b);
+  std::vector<VertexHandle> region_vertices;
+  const CaptureResult measured = end_capture(capture, &region_vertices);
+  for (VertexHandle v : region_vertices) {
+    v->info().area = -1.0;
+    v->info().short_edges = 0;
+  }
+  for (VertexHandle v : region_vertices) {
+    touch(v);
+    add_to_simplify(v);
+  }
+  // The flips that restore the Delaunay property change the surface a little: the caller
+  // gives the volume back with the stamp's deposit.
+  return measured.delta();
+}
+
 StampReport TinTerrain::stamp(const ToolStamp& s) {
+  // The constraints of stamps that have passed only kept their walls from being flipped:
+  // dropped, so the surface between old stamps is free to relax and coarsen (the Delaunay
+  // triangulation minimises roughness, Rippa 1990).
+  const double unconstrained = drop_stale_constraints(s.generation);
+  stale_delta_ = spec_.conserve_volume ? unconstrained : 0.0;
   if (s.is_pour()) return pour(s);
   if (s.footprint.size() < 3) throw InputError("stamp: the footprint needs at least 3 points");
   for (const Vec2& p : s.footprint)
@@ -134,6 +169,16 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   drop_near_duplicates(footprint, tiny);
   const double area = std::abs(signed_area(footprint));
   if (footprint.size() < 3 || !(area > 0.0)) throw InputError("stamp: the footprint has zero area");
+  // A many-sided convex tool (tool.sides up to 4096) is cut to kMaxSides evenly spaced
+  // corners: the mesh resolves no more (contour edges would be far below refine_m_), and
+  // each corner costs insertions, constraints and removals. A subset of a convex polygon's
+  // corners is convex and inscribed, so in_footprint still holds inside it.
+  constexpr std::size_t kMaxSides = 64;
+  if (footprint.size() > kMaxSides && is_convex(footprint)) {
+    std::vector<Vec2> fewer;
+    for (std::size_t k = 0; k < kMaxSides; ++k) fewer.push_back(footprint[k * footprint.size() / kMaxSides]);
+    footprint.swap(fewer);
+  }
   // Its edges become constraints, which must not cross.
   if (!is_convex(footprint) && !is_simple_polygon(footprint))
     throw InputError("stamp: the footprint must be a simple polygon (its edges cross)");
@@ -335,6 +380,8 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   if (i_verts.size() >= 3) constrain_ring(i_verts);
 
   // 1d: heights inside lowered to the tool; the volume taken is exact (barycentric areas).
+  // A tool deeper than the bed stops at its floor, z = 0: there is no sand below to push away.
+  auto bottom = [&s](const Vec2& p) { return std::max(s.bottom_z(p), 0.0); };
   std::vector<VertexHandle> inside;
   std::vector<VertexHandle> changed;
   const Aabb2 footprint_box = intersect(bounds(footprint).expanded(margin), box_);
@@ -344,7 +391,7 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
     const Vec2 p = xy(v);
     if (!in_footprint(p)) continue;
     inside.push_back(v);
-    const double z = v->point().z(), tool = s.bottom_z(p);
+    const double z = v->point().z(), tool = bottom(p);
     if (z > tool) {
       lowered_volume += (z - tool) * vertex_area(v);
       set_z(v, tool);
@@ -359,13 +406,13 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   for (VertexHandle v : inside) {
     const Vec2 p = xy(v);
     if (is_own(v) || v->info().border || distance_to_boundary(footprint, p) <= tiny || has_constraints(v)) continue;
-    if (std::abs(v->point().z() - s.bottom_z(p)) > level_eps) continue;
+    if (std::abs(v->point().z() - bottom(p)) > level_eps) continue;
     bool deeper = false;
     auto c = cdt_.incident_vertices(v), done = c;
     do {
       if (cdt_.is_infinite(c)) continue;
       const Vec2 q = xy(c->point());
-      const double tool = in_footprint(q) ? s.bottom_z(q) : s.pose.bottom_z;
+      const double tool = in_footprint(q) ? bottom(q) : std::max(s.pose.bottom_z, 0.0);
       deeper = deeper || c->point().z() < tool - level_eps;
     } while (++c != done && !deeper);
     if (!deeper) redundant.push_back(v);
@@ -392,7 +439,7 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
 
   // 1d (cont.): the displaced volume goes to the rim band, weighted by the common rule. The
   // band's vertices first get short edges (refine_around), so the sand stays in the band.
-  double deposit = lowered_volume - (spec_.conserve_volume ? surface_change : 0.0);
+  double deposit = lowered_volume - (spec_.conserve_volume ? surface_change : 0.0) - stale_delta_;
   const Aabb2 band_box = intersect(s.influence_bounds(), box_);
   collect_vertices(band_box, vertex_scratch_);
   std::vector<VertexHandle> band_vertices;
@@ -485,7 +532,7 @@ StampReport TinTerrain::pour(const ToolStamp& s) {
 
   // The volume lands as a cone of the pour radius (weights 1 - d / r times vertex areas), on
   // vertices with short edges (refine_around), so the sand stays within the radius.
-  const double volume = s.pour_volume_m3 - (spec_.conserve_volume ? measured.delta() : 0.0);
+  const double volume = s.pour_volume_m3 - (spec_.conserve_volume ? measured.delta() : 0.0) - stale_delta_;
   const Aabb2 reach = intersect(Aabb2{centre, centre}.expanded(radius), box_);
   collect_vertices(reach, vertex_scratch_);
   std::vector<VertexHandle> receivers;

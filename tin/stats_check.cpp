@@ -45,7 +45,9 @@ double TinTerrain::volume() const {
 ModelStats TinTerrain::stats() const {
   ModelStats st;
   st.vertices = cdt_.number_of_vertices();
-  st.triangles = cdt_.number_of_faces();
+  // Every border vertex is on the convex hull (the domain's sides are straight) and has one
+  // infinite face: O(1) where number_of_faces() circulates the hull.
+  st.triangles = cdt_.dimension() == 2 ? cdt_.tds().number_of_faces() - hull_vertices_ : cdt_.number_of_faces();
   st.constrained_edges = generations_.size();
   st.walk_steps = walk_steps_;
   st.active = erosion_list_.size();
@@ -60,7 +62,8 @@ ModelStats TinTerrain::stats() const {
       (generations_.bucket_count() > 1 ? generations_.bucket_count() * sizeof(void*) : 0) + generations_.size() * node;
   bytes += vector_bytes(erosion_list_) + vector_bytes(simplify_list_) + vector_bytes(nbr_scratch_) +
            vector_bytes(transfer_scratch_) + vector_bytes(vertex_scratch_) + vector_bytes(face_scratch_) +
-           vector_bytes(link_scratch_);
+           vector_bytes(link_scratch_) + vector_bytes(work_scratch_) + vector_bytes(redundant_scratch_) +
+           vector_bytes(link_hold_scratch_);
   st.bytes = bytes;
   return st;
 }
@@ -163,6 +166,8 @@ IntegrityReport TinTerrain::check() const {
         problem("simplification list slot mismatch");
     }
   }
+  if (cdt_.tds().number_of_faces() - hull_vertices_ != cdt_.number_of_faces())
+    problem("the hull vertex count is stale (" + std::to_string(hull_vertices_) + ")");
   if (in_erosion != erosion_list_.size()) problem("erosion list holds vertices that are not marked in it");
   if (in_simplify != simplify_list_.size()) problem("simplification list holds vertices that are not marked in it");
 

@@ -30,10 +30,15 @@
 //   volume, mesh, check, max_slope_deg: O(n); sample: O(raster points), walking row by row
 // Volume: stamps, erosion and simplification conserve volume except where the Delaunay
 // triangulation changes under a non-planar surface (flips after insertions and edge splits,
-// removals of not quite planar vertices). tin.conserve_volume measures each such change
-// over the faces it touched and gives it back (to the rim deposit, the split vertex, the
-// hole's vertices): exact to rounding, at the cost of one local face traversal per split
-// and per removal.
+// removals of not quite planar vertices, dropped constraints). tin.conserve_volume (the
+// default) measures each such change over the faces it touched and gives it back (to the
+// rim deposit, the split vertex, the hole's vertices): exact to rounding, at the cost of one
+// local face traversal per split and per removal.
+// Point location walks from the last located face; its guard uses the data structure's O(1)
+// face count (CGAL's number_of_faces() circulates the hull: O(sqrt(n)) with border points).
+// Stale constraints (of stamps before the current one) are dropped at each stamp. A tool
+// deeper than the bed stops at z = 0. Erosion re-activates one ring (the giver's
+// neighbours, the receivers themselves); tan_settle is its settling criterion.
 // Not thread-safe: height() and sample() move the walk hint.
 #include <memory>
 #include <vector>

@@ -14,7 +14,7 @@
 #include "common/reference.hpp"
 #include "common/scene.hpp"
 #include "common/schedule.hpp"
-#include "harness/backends.hpp"
+#include "harness/run/backends.hpp"
 
 namespace sb {
 namespace {

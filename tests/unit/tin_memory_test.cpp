@@ -102,7 +102,7 @@ TEST(TinMemory, BytesMatchAllocatorAccounting) {
       for (const ToolStamp& st : schedule_of(s).stamps) step(*t, s, st);
       return t;
     });
-    ASSERT_GT(c.terrain->stats().constrained_edges, 100u);
+    ASSERT_GT(c.terrain->stats().constrained_edges, 30u);  // the last stamp's
     ASSERT_GT(c.terrain->stats().active, 0u);
     expect_bytes_match(c, 0.02, "flat, after a stroke");
   }

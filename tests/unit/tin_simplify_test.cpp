@@ -1,6 +1,7 @@
 // Simplification on the TIN (the paper's step 3): only flat vertices go; border and
 // constrained vertices stay; flat regions simplify completely, step by step.
 #include <map>
+#include <numbers>
 #include <random>
 #include <set>
 
@@ -50,7 +51,8 @@ std::map<Key, double> edge_angles(const SurfaceMesh& m) {
 }
 
 TEST(TinSimplify, OnlyFlatVerticesAreRemoved) {
-  const Scene s = scene();
+  // The paper's step 3 as it is: removals not compensated, so the planes stay exact.
+  const Scene s = scene(kFlatScene, {"tin.conserve_volume=false"});
   auto t = two_plane_tin(s);
   // A tool above the surface changes no height but brings new vertices into L_r.
   t->stamp(stamp_at(s, {0.12, 0.25}, 0.5));
@@ -121,6 +123,40 @@ TEST(TinSimplify, ConserveVolumeSpreadsTheRemovalsChange) {
   EXPECT_GT(removed, 50u);
   EXPECT_NEAR(t->volume(), v0, 1e-13 * v0);
   SB_EXPECT_TIN_OK(*t);
+}
+
+TEST(TinSimplify, CoarseningRemovesSettledNearPlanarVerticesAndKeepsTheVolume) {
+  // A tilted plane (5 degrees, steeper than alpha_flat) with 0.02 mm noise: the paper's rule
+  // removes nothing, near-planar coarsening most of it, with the volume kept.
+  for (bool coarsen : {false, true}) {
+    const Scene s =
+        scene(kFlatScene, {std::string("tin.coarsen=") + (coarsen ? "true" : "false"), "tin.planar_tolerance_m=1e-4"});
+    std::mt19937_64 rng(9);
+    std::uniform_real_distribution<double> u(0.1, 0.9), noise(-2e-5, 2e-5);
+    std::vector<Vec3> pts;
+    for (int i = 0; i < 900; ++i) {
+      const Vec2 p(((i % 30) + u(rng)) / 60.0, ((i / 30) + u(rng)) / 60.0);
+      pts.emplace_back(p.x(), p.y(), 0.1 + std::tan(5.0 * std::numbers::pi / 180.0) * p.x() + noise(rng));
+    }
+    auto t = make_tin_terrain_from_points(s, pts);
+    t->stamp(stamp_at(s, {0.1, 0.1}, 0.5));  // above the surface: every vertex it touches joins L_r
+    const double v0 = t->volume();
+    const std::size_t n0 = t->stats().vertices;
+    std::size_t removed = 0;
+    for (int round = 0; round < 50; ++round) {
+      t->erode(rule_of(s), ErosionBudget{8});  // nothing to move: the touched vertices settle
+      removed += t->simplify(SimplifyParams{0.4}).removed;
+    }
+    SB_EXPECT_TIN_OK(*t);
+    EXPECT_NEAR(t->volume(), v0, 1e-12 * v0);
+    if (coarsen) {
+      EXPECT_GT(removed, n0 / 10) << "settled, near-planar vertices go";
+      for (double x : {0.1, 0.2, 0.3})
+        EXPECT_NEAR(t->height({x, 0.25}), 0.1 + std::tan(5.0 * std::numbers::pi / 180.0) * x, 3e-4);
+    } else {
+      EXPECT_EQ(removed, 0u) << "none is flatter than alpha_flat";
+    }
+  }
 }
 
 TEST(TinSimplify, RefusesABadAngle) {

@@ -88,7 +88,8 @@ TEST(TinStamp, DisplacedVolumeGoesToTheRim) {
   // The inside is cut by 1 cm, the O-I wall by about half of that.
   EXPECT_GT(r.volume_removed_m3, area * 0.01);
   EXPECT_LT(r.volume_removed_m3, area * 0.01 * 1.15);
-  EXPECT_DOUBLE_EQ(r.volume_deposited_m3, r.volume_removed_m3);
+  // Equal but for the retriangulation's rounding, which tin.conserve_volume gives back.
+  EXPECT_NEAR(r.volume_deposited_m3, r.volume_removed_m3, 1e-9 * r.volume_removed_m3);
   // On flat sand the contours and rim rings change nothing else: the volume is kept.
   EXPECT_NEAR(t->volume(), v0, 1e-15);
   // The sand went to the band outside the footprint, more of it in front.
@@ -114,7 +115,7 @@ TEST(TinStamp, ConserveVolumeCompensatesRetriangulation) {
   }
 }
 
-TEST(TinStamp, OldGenerationsInsideTheFootprintAreDropped) {
+TEST(TinStamp, OldGenerationsAreDroppedOnceTheStampHasPassed) {
   const Scene s = scene();
   auto t = make(s);
   t->stamp(stamp_at(s, {0.25, 0.25}, 0.09, {1, 0}, 0));
@@ -123,15 +124,17 @@ TEST(TinStamp, OldGenerationsInsideTheFootprintAreDropped) {
   t->stamp(stamp_at(s, {0.25, 0.25}, 0.09, {1, 0}, 1));
   SB_EXPECT_TIN_OK(*t);
   EXPECT_EQ(t->stats().constrained_edges, 64u);
-  // A stamp far away keeps the first one's constraints.
+  // A stamp far away: the first one has passed, its constraints are dropped.
   t->stamp(stamp_at(s, {0.1, 0.1}, 0.09, {1, 0}, 2));
   SB_EXPECT_TIN_OK(*t);
-  EXPECT_EQ(t->stats().constrained_edges, 128u);
-  // A stamp half over the first: the part of its contours out of reach stays.
+  EXPECT_EQ(t->stats().constrained_edges, 64u);
+  // A stamp half over the first: only its own contours are constrained (in more pieces where
+  // they pass through old vertices).
   t->stamp(stamp_at(s, {0.27, 0.25}, 0.09, {1, 0}, 3));
   SB_EXPECT_TIN_OK(*t);
-  EXPECT_GT(t->stats().constrained_edges, 128u);
-  EXPECT_LT(t->stats().constrained_edges, 192u);
+  EXPECT_GE(t->stats().constrained_edges, 64u);
+  EXPECT_LT(t->stats().constrained_edges, 128u);
+  EXPECT_NEAR(t->volume(), 0.025, 1e-12);
 }
 
 TEST(TinStamp, RemovesRedundantInnerVertices) {
@@ -160,7 +163,7 @@ TEST(TinStamp, NearTheBorderAndOffTheDomain) {
   for (const Vec2& c : {Vec2(0.005, 0.25), Vec2(0.499, 0.001), Vec2(0.5, 0.5), Vec2(0.0, 0.0), Vec2(0.25, -0.019)}) {
     const StampReport r = t->stamp(stamp_at(s, c, 0.09));
     SB_EXPECT_TIN_OK(*t);
-    EXPECT_NEAR(r.volume_deposited_m3, r.volume_removed_m3, 1e-18);
+    EXPECT_NEAR(r.volume_deposited_m3, r.volume_removed_m3, 1e-9 * r.volume_removed_m3 + 1e-18);
   }
   EXPECT_NEAR(t->volume(), v0, 1e-6 * v0);
   // Constrained edges never run along the domain border.
@@ -178,10 +181,22 @@ TEST(TinStamp, ToolAboveTheSurfaceRemovesNothing) {
   auto t = make(s);
   const StampReport r = t->stamp(stamp_at(s, {0.25, 0.25}, 0.2));
   EXPECT_EQ(r.volume_removed_m3, 0.0);
-  EXPECT_EQ(r.volume_deposited_m3, 0.0);
+  EXPECT_NEAR(r.volume_deposited_m3, 0.0, 1e-15);  // the contours' rounding, given back
   EXPECT_NEAR(t->volume(), 0.025, 1e-15);
   EXPECT_DOUBLE_EQ(t->height({0.25, 0.25}), 0.1);
   SB_EXPECT_TIN_OK(*t);
+}
+
+TEST(TinStamp, AToolDeeperThanTheBedStopsAtItsFloor) {
+  const Scene s = scene();
+  auto t = make(s);
+  const double v0 = t->volume();
+  const StampReport r = t->stamp(stamp_at(s, {0.25, 0.25}, -5.0));  // the bed is 0.1 m deep
+  SB_EXPECT_TIN_OK(*t);
+  EXPECT_NEAR(t->height({0.25, 0.25}), 0.0, 1e-12);
+  EXPECT_GT(r.volume_removed_m3, 0.0);
+  EXPECT_NEAR(t->volume(), v0, 1e-12 * v0);
+  for (const Vec3& v : t->mesh().vertices) EXPECT_GE(v.z(), -1e-12);
 }
 
 TEST(TinStamp, PourAddsItsVolumeWithinItsRadius) {

@@ -110,6 +110,10 @@ struct CaptureResult {
   double delta() const { return volume_after - volume_before; }
 };
 
+// The edge length erosion refines to when tin.refine_m is 0: 4 tin.tolerance_m / tan(critical
+// angle), at most 5 % of the domain (build.cpp).
+double default_refine_m(const Scene& scene);
+
 class TinTerrain final : public Terrain {
  public:
   explicit TinTerrain(const Scene& scene);
@@ -168,6 +172,10 @@ class TinTerrain final : public Terrain {
 
   // stamp.cpp
   StampReport pour(const ToolStamp& s);
+  // Unconstrains every edge of a generation older than `generation` and returns the volume
+  // change of the flips (the stamp's deposit gives it back); O(constrained edges + region).
+  double drop_stale_constraints(std::uint32_t generation);
+  double stale_delta_ = 0.0;  // the current stamp's share of that change
   // erosion.cpp: splits edge (a, b) at its middle (volume change measured, and compensated
   // under tin.conserve_volume); returns the vertex there.
   VertexHandle split_edge(VertexHandle a, VertexHandle b, bool* inserted);
@@ -176,6 +184,9 @@ class TinTerrain final : public Terrain {
   double gather_neighbours(VertexHandle v);
   // Splits v's edges longer than refine_m_ until none is; returns the number of splits.
   std::size_t refine_around(VertexHandle v);
+  // simplify.cpp: whether a triangle of the retriangulated hole (all its vertices in `link`)
+  // is steeper than the stable slope.
+  bool hole_is_steep(const std::vector<VertexHandle>& link) const;
   // build.cpp
   void insert_corners(const std::function<double(const Vec2&)>& z);
   void finish_build();
@@ -184,8 +195,11 @@ class TinTerrain final : public Terrain {
   Aabb2 box_;
   TinSpec spec_;
   int idle_passes_ = 2;
-  double refine_m_ = 0.0;     // edge length above which erosion splits an edge it flows across
-  double tool_size_m_ = 0.0;  // characteristic radius of the scene's tool
+  double refine_m_ = 0.0;      // edge length above which erosion splits an edge it flows across
+  double tool_size_m_ = 0.0;   // characteristic radius of the scene's tool
+  double settle_dz_ = 0.0;     // coarsening: removals may not make an edge steeper by this much
+  double tan_critical_ = 0.0;  // the scene material's, for coarsening
+  double tan_settle_ = 0.0;    // and the steepest stable slope (erosion.settle_tolerance_deg)
   TerrainKind kind_ = TerrainKind::Flat;
   double base_height_m_ = 0.0;
 
@@ -194,6 +208,7 @@ class TinTerrain final : public Terrain {
   std::vector<VertexHandle> erosion_list_;                               // L_e
   std::vector<VertexHandle> simplify_list_;                              // L_r
 
+  std::size_t hull_vertices_ = 0;  // border vertices (all on the convex hull)
   mutable VertexHandle hint_;
   mutable std::uint64_t walk_steps_ = 0;
   mutable std::uint32_t rng_ = 0x9E3779B9u;
@@ -207,6 +222,9 @@ class TinTerrain final : public Terrain {
   std::vector<VertexHandle> vertex_scratch_;
   std::vector<FaceHandle> face_scratch_;
   std::vector<VertexHandle> link_scratch_;
+  std::vector<VertexHandle> work_scratch_;       // erosion: the pass's copy of L_e
+  std::vector<VertexHandle> redundant_scratch_;  // simplify: vertices to remove
+  std::vector<VertexHandle> link_hold_scratch_;  // simplify: the removed vertex's link
 };
 
 // Area of a finite face projected on the xy plane (positive: faces are counter-clockwise).

@@ -1,0 +1,58 @@
+#pragma once
+// Session files: what `sandbench interactive --record FILE` writes and `sandbench run
+// --replay FILE` (or `--device replay:FILE`) reads. One CSV file of tables, each introduced by
+// its header line, after '#' comment lines:
+//   # sandbench session 1 / # scene: ... / # backend: ... / # set key=value (scene overrides
+//     the session made, e.g. material sliders; replay applies them before its own --set)
+//   t,x,y,z,buttons                 the device trajectory (README: the replay format)
+//   t,fx,fy,fz,penetration_m        the force sent at each of those ticks
+//   tool,shape,radius_m,...         every tool used, in full
+//   stamp,t,x,y,bottom_z,heading_rad,dir_x,dir_y,tool   every stamp applied, in order
+// Numbers are written with round-trip precision, so replayed stamps are the recorded ones
+// bit for bit. Reading and writing are O(file); writing is whole-or-nothing.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "common/haptics/trajectory.hpp"
+#include "common/schedule.hpp"
+#include "common/tool.hpp"
+
+namespace sb {
+
+struct SessionStamp {
+  double t_s = 0.0;  // servo time when applied
+  ToolPose pose;
+  Vec2 motion_dir{0.0, 0.0};
+  std::size_t tool = 0;  // index into Session::tools
+};
+
+struct SessionForce {
+  double t_s = 0.0;
+  Vec3 force_n{0.0, 0.0, 0.0};
+  double penetration_m = 0.0;
+};
+
+struct Session {
+  std::string scene;                   // informational
+  std::string backend;                 // informational
+  std::vector<std::string> overrides;  // "key=value"
+  haptics::Trajectory trajectory;
+  std::vector<SessionForce> forces;  // one per trajectory sample, or none
+  std::vector<ToolSpec> tools;
+  std::vector<SessionStamp> stamps;
+};
+
+void write_session(const std::filesystem::path& file, const Session& session);
+// Throws InputError naming the file, line and column of anything malformed; `option` (e.g.
+// "--replay") prefixes the message.
+Session read_session(const std::filesystem::path& file, const std::string& option);
+
+// The stamps of a session as a schedule (generations renumbered from 0). O(stamps).
+StampSchedule session_schedule(const Session& session);
+
+// Adds `tool` to the session's tool table unless an identical one is there; its index.
+std::size_t session_tool_index(Session& session, const ToolSpec& tool);
+
+}  // namespace sb
