@@ -11,6 +11,7 @@ packages=(
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   python3-numpy python3-matplotlib python3-h5py
   libglfw3-dev libimgui-dev xvfb xauth
+  munge slurmctld slurmd slurm-client  # the slurm test's own cluster (it starts and stops the daemons)
 )
 
 # `deps.sh fuzz` adds clang and its libFuzzer runtime (for `make fuzz` only).

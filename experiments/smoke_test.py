@@ -1,11 +1,16 @@
 #!/usr/bin/python3
 """Smoke test of the reproduction (run by CTest): the driver on the tiny profile into a
-temporary folder; every figure and table must appear and every table must hold numbers."""
+temporary folder, stopped after a few runs and started again (it must finish only the rest);
+every figure and table must appear and every table must hold numbers; a third start runs
+nothing and writes the same bytes."""
 import csv
 import math
+import re
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -21,7 +26,19 @@ def main():
     with tempfile.TemporaryDirectory() as tmp:
         cmd = ["/usr/bin/python3", str(HERE / "reproduce.py"), "--sandbench", sandbench, "--results", tmp,
                "--profile", "tiny"]
-        subprocess.run(cmd, check=True)
+        # Stopped once a few runs are done, then started again: it must finish only the rest.
+        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        while proc.poll() is None and len(finished_runs(tmp)) < 4:
+            time.sleep(0.1)
+        proc.send_signal(signal.SIGTERM)
+        proc.wait()
+        before = finished_runs(tmp)
+        second = subprocess.run(cmd, check=True, capture_output=True, text=True)
+        todo = re.findall(r"round 1: (\d+) runs to do", second.stderr)
+        after = finished_runs(tmp)
+        if todo != [str(len(after) - len(before))] or any(after[n] != t for n, t in before.items()):
+            sys.exit(f"a stopped reproduction with {len(before)} of {len(after)} runs done did not resume: "
+                     f"the second start did {todo} runs\n{second.stderr[-3000:]}")
         out = Path(tmp)
         missing = [f for f in FIGURES if not (out / f).exists() or (out / f).stat().st_size == 0]
         missing += [f"{t}.{e}" for t in TABLES for e in ("md", "csv") if not (out / f"{t}.{e}").exists()]
@@ -40,9 +57,22 @@ def main():
                         "Accuracy", "Stability"]:
             if heading not in report:
                 sys.exit(f"REPORT.md has no section for {heading}")
-        # A second run resumes: nothing is run again.
-        subprocess.run(cmd, check=True, capture_output=True)
+        # A third start runs nothing and rewrites every output with the same bytes (SVGs included).
+        outputs = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+        third = subprocess.run(cmd, check=True, capture_output=True, text=True)
+        if "runs to do" in third.stderr or finished_runs(tmp) != after:
+            sys.exit(f"the third start ran something again:\n{third.stderr[-3000:]}")
+        changed = [n for n, b in outputs.items() if (out / n).read_bytes() != b]
+        if changed:
+            sys.exit(f"outputs rewritten with other bytes from the same runs: {changed}")
     print("1 passed, 0 failed")
+
+
+def finished_runs(results):
+    """{run name: sidecar mtime} of the finished runs."""
+    runs = Path(results) / "runs"
+    return {str(p.relative_to(runs)): p.stat().st_mtime_ns for p in runs.rglob("*.json")
+            if ".slurm" not in p.parts and '"key"' in p.read_text()} if runs.exists() else {}
 
 
 def _is_number(c):
