@@ -102,7 +102,7 @@ class SlurmEngine:
         pending = state / "pending.json"
         if pending.exists():  # a driver killed without cleaning up: its array may still be running
             old = json.loads(pending.read_text())["job"]
-            if self._active(old):
+            if self._active(old) != []:
                 progress(f"slurm: job array {old} of an earlier start is still queued; waiting for it first")
                 self._wait(old)
             pending.unlink()
@@ -143,17 +143,24 @@ class SlurmEngine:
         progress(f"slurm: job array {job} finished ({len(batches)} tasks)")
 
     def _active(self, job):
-        """States of the array's tasks still in the queue (empty when the array has left it)."""
+        """States of the array's tasks still in the queue (empty when the array has left it);
+        None when squeue could not answer (the controller busy or restarting: ask again)."""
         proc = subprocess.run(["squeue", "--noheader", "--array", f"--jobs={job}", "--format=%T"],
                               capture_output=True, text=True)
-        if proc.returncode != 0:  # an unknown job id: long finished and purged
-            return []
+        if proc.returncode != 0:
+            if "Invalid job id" in proc.stderr:  # long finished and purged from the controller
+                return []
+            progress(f"slurm: squeue failed, asking again: {proc.stderr.strip()}")
+            return None
         return proc.stdout.split()
 
     def _wait(self, job, tasks=None):
         last = None
         while True:
             states = self._active(job)
+            if states is None:
+                time.sleep(max(self.poll_s, 5.0))
+                continue
             if not states:
                 return
             running = states.count("RUNNING")

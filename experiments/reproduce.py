@@ -11,6 +11,7 @@ a second one runs nothing."""
 import argparse
 import os
 import platform
+import resource
 import subprocess
 import time
 from pathlib import Path
@@ -136,7 +137,11 @@ def main():
     names = args.only or list(EXPERIMENTS)
     sbrun.progress(f"reproduce: {len(names)} experiments, profile {ctx.profile_name}, {ctx.engine.name} engine, "
                    f"binary {ctx.binary['version']}")
+    start = time.monotonic()
     sections = run_experiments(ctx, names)
+    cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
+    sbrun.progress(f"reproduce: {time.monotonic() - start:.0f} s wall, {cpu.ru_utime + cpu.ru_stime:.0f} s CPU in "
+                   f"processes run on this machine")
     if engine is not None:
         sbrun.progress(f"slurm: waited for job arrays {' '.join(engine.job_ids) or '(none: every run was done)'}")
 

@@ -12,7 +12,7 @@ overrides and the time limit. The name is only where the files go.
 Files of run NAME, in the runs folder:
   NAME.h5    the run file (sandbench writes it under a temporary name and renames it whole)
   NAME.json  the sidecar, written atomically after the run ends: key, identity, binary
-             (commit and build), exit code, the end of stderr, the summary, wall time.
+             (commit and build), exit code, the end of stderr, the summary, wall and CPU time.
 A run is reused only when its sidecar holds the same key (and, for a run that succeeded,
 its run file exists); anything else -- no sidecar, a sidecar from another binary or other
 inputs, an older sidecar format -- runs again. Killing a sweep therefore loses at most the
@@ -25,6 +25,7 @@ import re
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from pathlib import Path
@@ -160,19 +161,31 @@ def execute(spec):
     cmd = command(spec)
     Path(spec["runs"], spec["name"]).parent.mkdir(parents=True, exist_ok=True)
     start = time.monotonic()
-    proc = subprocess.Popen(cmd, cwd=spec["runs"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    with _children_lock:
-        _children.add(proc)
-    try:
-        out, err = proc.communicate(timeout=spec["timeout"])
-        code = proc.returncode
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        out, err = proc.communicate()
-        code = None
-    finally:
+    # Output to files and our own wait4, to learn the run's CPU time (what a cluster bills).
+    with tempfile.TemporaryFile("w+") as fout, tempfile.TemporaryFile("w+") as ferr:
+        proc = subprocess.Popen(cmd, cwd=spec["runs"], stdout=fout, stderr=ferr, text=True)
         with _children_lock:
-            _children.discard(proc)
+            _children.add(proc)
+        timed_out = threading.Event()
+
+        def kill():
+            timed_out.set()
+            proc.kill()
+        timer = threading.Timer(spec["timeout"], kill) if spec["timeout"] else None
+        if timer:
+            timer.start()
+        try:
+            _, status, usage = os.wait4(proc.pid, 0)
+        finally:
+            if timer:
+                timer.cancel()
+            with _children_lock:
+                _children.discard(proc)
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        code = None if timed_out.is_set() else proc.returncode
+        fout.seek(0)
+        ferr.seek(0)
+        out, err = fout.read(), ferr.read()
     if code != 0 and spec["check"]:
         raise RunFailed(f"sandbench failed ({code}): {' '.join(cmd)} (in {spec['runs']})\n{err[-STDERR_KEPT:]}")
     summary = {}
@@ -180,7 +193,8 @@ def execute(spec):
         summary = json.loads(out)
     side = {"format": SIDECAR_FORMAT, "key": spec["key"], "name": spec["name"], "identity": spec["identity"],
             "binary": spec["binary"], "exit": code, "stderr": err[-STDERR_KEPT:], "summary": summary,
-            "wall_s": round(time.monotonic() - start, 3), "finished": time.strftime("%Y-%m-%d", time.gmtime())}
+            "wall_s": round(time.monotonic() - start, 3), "cpu_s": round(usage.ru_utime + usage.ru_stime, 3),
+            "finished": time.strftime("%Y-%m-%d", time.gmtime())}
     path = sidecar_path(spec)
     tmp = path.with_name(f"{path.name}.tmp{os.getpid()}.{threading.get_ident()}")
     tmp.write_text(json.dumps(side, indent=1) + "\n")
