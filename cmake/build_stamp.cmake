@@ -11,8 +11,15 @@
 # tree differs from it there; without git (a source tarball) it is "unknown" and the identity
 # still holds.
 #
-# Inputs: -DSB_SOURCE_DIR= -DSB_STAMP_OUT= -DSB_STAMP_CONFIG= -DSB_STAMP_DIRS=a;b;c
+# Inputs: -DSB_SOURCE_DIR= -DSB_STAMP_OUT= -DSB_STAMP_CONFIG= -DSB_STAMP_DIRS=a,b,c (commas: a
+# semicolon would split the argument in a custom command).
 # Cost: reads every source file once (about 1 MB, well under a second).
+
+string(REPLACE "," ";" SB_STAMP_DIRS "${SB_STAMP_DIRS}")
+list(LENGTH SB_STAMP_DIRS n)
+if(n LESS 2)
+  message(FATAL_ERROR "build_stamp.cmake: SB_STAMP_DIRS lists ${n} folder(s): '${SB_STAMP_DIRS}'")
+endif()
 
 set(files)
 foreach(entry IN LISTS SB_STAMP_DIRS)

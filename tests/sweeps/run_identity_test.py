@@ -47,6 +47,15 @@ def main():
     if not m:
         sys.exit(f"--version printed {version!r}")
     commit, build = m.groups()
+    # The stamp's commit is the last one that changed the binary's folders (all of them).
+    dirs = ["common", "grid", "tin", "harness", "cmake", "CMakeLists.txt", "CMakePresets.json"]
+    git = subprocess.run(["git", "-C", str(ROOT), "log", "-1", "--format=%h", "--abbrev=12", "--", *dirs],
+                         capture_output=True, text=True)
+    if git.returncode == 0 and git.stdout.strip():
+        dirty = subprocess.run(["git", "-C", str(ROOT), "status", "--porcelain", "--", *dirs],
+                               capture_output=True, text=True).stdout.strip()
+        expect("--version's commit is the last commit of the sources", commit,
+               git.stdout.strip() + ("-dirty" if dirty else ""))
     with tempfile.TemporaryDirectory(prefix="sbident-") as tmp:
         tmp = Path(tmp)
         other = tmp / "other-sandbench"
