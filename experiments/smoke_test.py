@@ -14,6 +14,8 @@ import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "tests" / "sweeps"))
+from sweep_checks import sidecars  # noqa: E402  {finished run: (sidecar mtime, key)}
 FIGURES = ["fig5_tin_shaded.png", "fig5_tin_wireframe.png", "fig6_grid_shaded.png", "fig5_6_side_by_side.png",
            "fig5_6_difference.png", "fig7_time_vs_size.png", "fig8_time_vs_trace.png", "fig9_elements_vs_trace.png",
            "memory.png", "drift.png", "alpha_flat.png", "accuracy_speed.png"]
@@ -28,14 +30,14 @@ def main():
                "--profile", "tiny"]
         # Stopped once a few runs are done, then started again: it must finish only the rest.
         proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        while proc.poll() is None and len(finished_runs(tmp)) < 4:
+        while proc.poll() is None and len(sidecars(tmp)) < 4:
             time.sleep(0.1)
         proc.send_signal(signal.SIGTERM)
         proc.wait()
-        before = finished_runs(tmp)
+        before = sidecars(tmp)
         second = subprocess.run(cmd, check=True, capture_output=True, text=True)
         todo = re.findall(r"round 1: (\d+) runs to do", second.stderr)
-        after = finished_runs(tmp)
+        after = sidecars(tmp)
         if todo != [str(len(after) - len(before))] or any(after[n] != t for n, t in before.items()):
             sys.exit(f"a stopped reproduction with {len(before)} of {len(after)} runs done did not resume: "
                      f"the second start did {todo} runs\n{second.stderr[-3000:]}")
@@ -60,19 +62,12 @@ def main():
         # A third start runs nothing and rewrites every output with the same bytes (SVGs included).
         outputs = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
         third = subprocess.run(cmd, check=True, capture_output=True, text=True)
-        if "runs to do" in third.stderr or finished_runs(tmp) != after:
+        if "runs to do" in third.stderr or sidecars(tmp) != after:
             sys.exit(f"the third start ran something again:\n{third.stderr[-3000:]}")
         changed = [n for n, b in outputs.items() if (out / n).read_bytes() != b]
         if changed:
             sys.exit(f"outputs rewritten with other bytes from the same runs: {changed}")
     print("1 passed, 0 failed")
-
-
-def finished_runs(results):
-    """{run name: sidecar mtime} of the finished runs."""
-    runs = Path(results) / "runs"
-    return {str(p.relative_to(runs)): p.stat().st_mtime_ns for p in runs.rglob("*.json")
-            if ".slurm" not in p.parts and '"key"' in p.read_text()} if runs.exists() else {}
 
 
 def _is_number(c):
