@@ -24,6 +24,7 @@ import exp_drift
 import exp_fig5_6
 import exp_fig7
 import exp_fig8_9
+import exp_haptics
 import exp_memory
 import exp_stability
 
@@ -36,6 +37,7 @@ EXPERIMENTS = {
     "alpha_flat": exp_alpha_flat,
     "accuracy": exp_accuracy,
     "stability": exp_stability,
+    "haptics": exp_haptics,
 }
 
 
