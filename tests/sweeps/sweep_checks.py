@@ -9,6 +9,9 @@ from pathlib import Path
 # A table column or summary key that holds a wall-clock measurement (or a quantity fitted to
 # one), which differs from run to run: "tool s", "step ms p50", "time s", "time_s.total"...
 TIMING = re.compile(r"(^|[\s_.])(s|ms)($|[\s_.])|time|per_s", re.IGNORECASE)
+# Tables measured in real time as a whole (the haptic replay: where the stamps fall depends on
+# how fast the simulation thread ran), compared by shape only: headers, rows, first column.
+REAL_TIME_TABLES = {"haptics.csv"}
 
 
 def sidecars(results):
@@ -45,7 +48,7 @@ def compare_tables(a, b):
         if ta[0] != tb[0] or len(ta) != len(tb):
             failures.append(f"{name}: different headers or row counts")
             continue
-        keep = [i for i, h in enumerate(ta[0]) if not TIMING.search(h)]
+        keep = [0] if name in REAL_TIME_TABLES else [i for i, h in enumerate(ta[0]) if not TIMING.search(h)]
         for ra, rb in zip(ta[1:], tb[1:]):
             if [ra[i] for i in keep] != [rb[i] for i in keep]:
                 failures.append(f"{name}: rows differ outside timing columns:\n  {ra}\n  {rb}")
