@@ -100,7 +100,7 @@ def main():
                 for job in waited:  # the cluster's own record of them (kept MinJobAge seconds)
                     info = cluster.run(["scontrol", "show", "job", job], check=False).stdout
                     states = sorted(set(re.findall(r"JobState=(\w+)", info)))
-                    log(f"  job {job}: {len(re.findall(r'JobId=', info))} array tasks, states {states}")
+                    log(f"  job {job}: {len(re.findall(r'(?<!Array)JobId=', info))} array tasks, states {states}")
             except BaseException:
                 log(cluster.logs())
                 raise
