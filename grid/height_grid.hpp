@@ -15,6 +15,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "common/bilinear.hpp"
 #include "grid/compensated_sum.hpp"
 #include "grid/grid_layout.hpp"
 
@@ -60,14 +61,9 @@ class HeightGrid {
 
   // Bilinear interpolation of the node heights, p clamped to the domain. O(1).
   double height(const Vec2& p) const {
-    const double gx = std::clamp((p.x() - layout_.origin.x()) / layout_.dx, 0.0, static_cast<double>(layout_.nx - 1));
-    const double gy = std::clamp((p.y() - layout_.origin.y()) / layout_.dy, 0.0, static_cast<double>(layout_.ny - 1));
-    const std::size_t ix = std::min(static_cast<std::size_t>(gx), layout_.nx - 2);
-    const std::size_t iy = std::min(static_cast<std::size_t>(gy), layout_.ny - 2);
-    const double tx = gx - static_cast<double>(ix), ty = gy - static_cast<double>(iy);
-    const std::size_t k = iy * layout_.nx + ix;
-    const double z00 = z_[k], z10 = z_[k + 1], z01 = z_[k + layout_.nx], z11 = z_[k + layout_.nx + 1];
-    return (1.0 - ty) * ((1.0 - tx) * z00 + tx * z10) + ty * ((1.0 - tx) * z01 + tx * z11);
+    return bilinear((p.x() - layout_.origin.x()) / layout_.dx, (p.y() - layout_.origin.y()) / layout_.dy, layout_.nx,
+                    layout_.ny,
+                    [&](std::size_t ix, std::size_t iy) { return static_cast<double>(z_[iy * layout_.nx + ix]); });
   }
 
   // The exact integral of the bilinear interpolant over the domain: sum of A_k z_k with

@@ -110,8 +110,9 @@ TEST_P(Regression, MetricsWithinGoldenBounds) {
   ASSERT_TRUE(in) << "no golden " << golden_path(c) << "; run `make goldens`";
   const auto golden = nlohmann::json::parse(in);
   // Whatever the golden says, a pile must stand at the critical angle (issue: within 2 degrees).
-  if (summary.contains("pile.flank_angle_deg"))
+  if (summary.contains("pile.flank_angle_deg")) {
     EXPECT_NEAR(summary["pile.flank_angle_deg"].get<double>(), 30.0, 2.0) << c.name;
+  }
   for (const auto& [metric, bound] : golden.at("metrics").items()) {
     ASSERT_TRUE(summary.contains(metric)) << metric;
     const double v = summary[metric].get<double>();
