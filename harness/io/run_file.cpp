@@ -130,6 +130,8 @@ void write_contents(hid_t file, const RunResult& run, const PreparedScene& p, co
   string_attribute(file, "label", run.label);
   string_attribute(file, "parameters", p.scene.resolved);
   string_attribute(file, "version", kVersion);
+  string_attribute(file, "commit", kCommit);
+  string_attribute(file, "build_id", kBuildId);
   string_attribute(file, "compiler", std::string(kCompiler) + " " + kBuildType);
   string_attribute(file, "date", utc_now());
   string_attribute(file, "summary", summary.dump());
