@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include "grid/grid_erosion.hpp"
 #include "grid/grid_stamp.hpp"
 
 namespace sb::grid {
@@ -12,7 +11,7 @@ namespace sb::grid {
 template <class Real>
 GridTerrain<Real>::GridTerrain(const GridLayout& layout, const std::function<double(const Vec2&)>& initial,
                                int neighbours, int idle_passes)
-    : grid_(layout, initial), stencil_(Stencil::make(layout, neighbours)), active_(layout.nodes(), idle_passes) {}
+    : grid_(layout, initial), stencil_(Stencil::make(layout, neighbours)), active_(layout.nx, layout.ny, idle_passes) {}
 
 template <class Real>
 StampReport GridTerrain<Real>::stamp(const ToolStamp& s) {
@@ -20,24 +19,24 @@ StampReport GridTerrain<Real>::stamp(const ToolStamp& s) {
   const StampReport report = stamp_grid(grid_, s, changed);
   const GridLayout& layout = grid_.layout();
   for (std::uint32_t k : changed) {
-    active_.activate(k);
     const auto [ix, iy] = layout.split(k);
-    stencil_.for_each(layout, ix, iy,
-                      [&](std::size_t jx, std::size_t jy, int) { active_.activate(layout.index(jx, jy)); });
+    active_.activate_block(ix, iy);
   }
   return report;
 }
 
 template <class Real>
 ErosionReport GridTerrain<Real>::erode(const ErosionRule& rule, const ErosionBudget& budget) {
-  return erode_grid(grid_, active_, stencil_, rule, budget);
+  const bool gradient = false;
+  if (!tables_ || !tables_->built_for(rule, gradient)) tables_.emplace(grid_.layout(), stencil_.size, rule, gradient);
+  return erode_ordered(grid_, active_, *tables_, budget);
 }
 
 template <class Real>
 ModelStats GridTerrain<Real>::stats() const {
   ModelStats st;
   st.cells = grid_.layout().nodes();
-  st.bytes = grid_.bytes() + active_.bytes();
+  st.bytes = grid_.bytes() + active_.bytes() + (tables_ ? tables_->bytes() : 0);
   st.active = active_.size();
   return st;
 }

@@ -35,8 +35,7 @@ class HeightGrid {
 
   const GridLayout& layout() const { return layout_; }
   const std::vector<Real>& heights() const { return z_; }
-  double z(std::uint32_t k) const { return static_cast<double>(z_[k]); }
-  double z(std::size_t ix, std::size_t iy) const { return z(layout_.index(ix, iy)); }
+  double z(std::size_t ix, std::size_t iy) const { return z(std::size_t{layout_.index(ix, iy)}); }
 
   // Stores `target` (m) at node k; with float storage the rounding error is carried on.
   void set(std::uint32_t k, double target) { set(k, target, layout_.area(k)); }
@@ -57,6 +56,18 @@ class HeightGrid {
   }
   // Volume (m^3) owed to the surface by rounding: true volume = volume() + carry_m3().
   double carry_m3() const { return carry_m3_; }
+
+  // The erosion kernel's storage concept (erosion_kernel.hpp): a plain rounded store that
+  // returns its rounding error (m), and the carry, which the kernel settles itself.
+  static constexpr bool kRounds = !std::is_same_v<Real, double>;
+  double z(std::size_t k) const { return static_cast<double>(z_[k]); }
+  double put(std::size_t k, double target) {
+    const Real stored = static_cast<Real>(target);
+    z_[k] = stored;
+    if constexpr (kRounds) return target - static_cast<double>(stored);
+    return 0.0;
+  }
+  double& carry() { return carry_m3_; }
 
   // Bilinear interpolation of the node heights, p clamped to the domain. O(1).
   double height(const Vec2& p) const {
