@@ -2,26 +2,41 @@
 
 #include <stdexcept>
 
+#include "grid/sparse_idle_counts.hpp"
+
 namespace sb::grid {
 
-ActiveSet::ActiveSet(std::size_t nx, std::size_t ny, int idle_passes)
+void DenseIdleCounts::check(const std::vector<std::uint64_t>& bits, std::size_t words_per_row,
+                            std::uint16_t idle_passes, std::vector<std::string>& problems) const {
+  for (std::size_t k = 0; k < counts_.size(); ++k) {
+    const std::size_t ix = k % nx_, iy = k / nx_;
+    const bool member = (bits[iy * words_per_row + ix / 64] >> (ix % 64)) & 1u;
+    if (counts_[k] >= idle_passes || (!member && counts_[k] != 0))
+      problems.push_back("active set: node " + std::to_string(k) + " idle count " + std::to_string(counts_[k]) +
+                         (member ? " >= idle_passes" : " but not a member"));
+  }
+}
+
+template <class Idle>
+BasicActiveSet<Idle>::BasicActiveSet(std::size_t nx, std::size_t ny, int idle_passes)
     : nx_(nx),
       ny_(ny),
       words_per_row_((nx + 63) / 64),
       idle_passes_(static_cast<std::uint16_t>(idle_passes)),
       bits_(words_per_row_ * ny, 0),
       row_count_(ny, 0),
-      idle_(nx * ny, 0) {
+      idle_(nx, ny, words_per_row_) {
   if (idle_passes < 1 || idle_passes > 32767)
     throw std::invalid_argument("ActiveSet: idle_passes must be in [1, 32767]");
 }
 
-std::size_t ActiveSet::bytes() const {
-  return bits_.capacity() * sizeof(std::uint64_t) + row_count_.capacity() * sizeof(std::uint32_t) +
-         idle_.capacity() * sizeof(std::uint16_t);
+template <class Idle>
+std::size_t BasicActiveSet<Idle>::bytes() const {
+  return bits_.capacity() * sizeof(std::uint64_t) + row_count_.capacity() * sizeof(std::uint32_t) + idle_.bytes();
 }
 
-void ActiveSet::check(std::vector<std::string>& problems) const {
+template <class Idle>
+void BasicActiveSet<Idle>::check(std::vector<std::string>& problems) const {
   std::size_t total = 0;
   for (std::size_t iy = 0; iy < ny_; ++iy) {
     std::size_t in_row = 0;
@@ -39,10 +54,10 @@ void ActiveSet::check(std::vector<std::string>& problems) const {
   }
   if (total != size_)
     problems.push_back("active set: " + std::to_string(total) + " members, size says " + std::to_string(size_));
-  for (std::size_t k = 0; k < idle_.size(); ++k)
-    if (idle_[k] >= idle_passes_)
-      problems.push_back("active set: node " + std::to_string(k) + " idle count " + std::to_string(idle_[k]) +
-                         " >= idle_passes");
+  idle_.check(bits_, words_per_row_, idle_passes_, problems);
 }
+
+template class BasicActiveSet<DenseIdleCounts>;
+template class BasicActiveSet<PagedIdleCounts>;
 
 }  // namespace sb::grid

@@ -3,7 +3,10 @@
 // rows, visited in storage order.
 //
 // Membership is one bit per node, rows padded to whole 64-bit words, plus a member count
-// per row; each node also keeps a 16-bit count of consecutive idle visits. A node that
+// per row; each member also keeps a 16-bit count of consecutive idle visits (a non-member's
+// count is 0), held by the Idle policy: DenseIdleCounts, one per node (the dense grid), or
+// PagedIdleCounts, a page of 64 counts per bitmap word that holds a member (the sparse
+// grid, sparse_idle_counts.hpp). The policy changes only where the counts live. A node that
 // transferred, and its 3 x 3 block, become members with a fresh idle count; an idle node
 // stays until it has been idle `idle_passes` times in a row.
 //
@@ -15,8 +18,9 @@
 // resolution (erosion_kernel.hpp). The order depends only on the heights and the pass
 // number, so the same input gives the same sequence of visits.
 //
-// Memory: 2 bytes + 1 bit per node, 4 bytes per row. activate_block / idle are O(1);
-// a sweep is O(rows + words of rows with members + visits).
+// Memory: 1 bit per node and 4 bytes per row, plus the counts: 2 bytes per node (dense),
+// or 128 bytes per word with members at the high-water mark and 4 bytes per word (paged).
+// activate_block / idle are O(1); a sweep is O(rows + words of rows with members + visits).
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -25,9 +29,28 @@
 
 namespace sb::grid {
 
-class ActiveSet {
+// One idle count per node.
+class DenseIdleCounts {
  public:
-  ActiveSet(std::size_t nx, std::size_t ny, int idle_passes);
+  DenseIdleCounts(std::size_t nx, std::size_t ny, std::size_t /*words_per_row*/) : nx_(nx), counts_(nx * ny, 0) {}
+  std::uint16_t& at(std::size_t ix, std::size_t iy) { return counts_[iy * nx_ + ix]; }
+  void reset(std::size_t ix, std::size_t iy) { counts_[iy * nx_ + ix] = 0; }
+  void word_filled(std::size_t /*word*/) {}   // a bitmap word got its first member
+  void word_emptied(std::size_t /*word*/) {}  // a bitmap word lost its last member
+  std::size_t bytes() const { return counts_.capacity() * sizeof(std::uint16_t); }
+  // Counts below idle_passes, zero for non-members.
+  void check(const std::vector<std::uint64_t>& bits, std::size_t words_per_row, std::uint16_t idle_passes,
+             std::vector<std::string>& problems) const;
+
+ private:
+  std::size_t nx_;
+  std::vector<std::uint16_t> counts_;
+};
+
+template <class Idle>
+class BasicActiveSet {
+ public:
+  BasicActiveSet(std::size_t nx, std::size_t ny, int idle_passes);
 
   // Node (ix, iy) changed: it and its 3 x 3 block (clipped to the grid) become members
   // with a fresh idle count.
@@ -35,22 +58,24 @@ class ActiveSet {
     const std::size_t y0 = iy > 0 ? iy - 1 : 0, y1 = iy + 1 < ny_ ? iy + 1 : iy;
     const std::size_t x0 = ix > 0 ? ix - 1 : 0, x1 = ix + 1 < nx_ ? ix + 1 : ix;
     for (std::size_t y = y0; y <= y1; ++y) {
-      for (std::size_t x = x0; x <= x1; ++x) idle_[y * nx_ + x] = 0;
       set_bits(y, x0, x1);
+      for (std::size_t x = x0; x <= x1; ++x) idle_.reset(x, y);
     }
   }
   // Node (ix, iy) alone becomes a member with a fresh idle count.
   void activate(std::size_t ix, std::size_t iy) {
-    idle_[iy * nx_ + ix] = 0;
     set_bits(iy, ix, ix);
+    idle_.reset(ix, iy);
   }
   // Node (ix, iy) was visited and stayed put: it leaves after idle_passes such visits in a row.
   void idle(std::size_t ix, std::size_t iy) {
-    std::uint16_t& count = idle_[iy * nx_ + ix];
+    std::uint16_t& count = idle_.at(ix, iy);
     if (++count < idle_passes_) return;
     count = 0;
-    std::uint64_t& w = bits_[iy * words_per_row_ + ix / 64];
+    const std::size_t word = iy * words_per_row_ + ix / 64;
+    std::uint64_t& w = bits_[word];
     w &= ~(std::uint64_t{1} << (ix % 64));
+    if (w == 0) idle_.word_emptied(word);
     --row_count_[iy];
     --size_;
   }
@@ -82,6 +107,7 @@ class ActiveSet {
       const std::uint64_t mask =
           (hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & ~((std::uint64_t{1} << lo) - 1);
       const int added = std::popcount(mask & ~row[wi]);
+      if (added > 0 && row[wi] == 0) idle_.word_filled(y * words_per_row_ + wi);
       row[wi] |= mask;
       row_count_[y] += static_cast<std::uint32_t>(added);
       size_ += static_cast<std::size_t>(added);
@@ -95,11 +121,12 @@ class ActiveSet {
   unsigned sweeps_ = 0;                   // sweeps so far: chooses the next sweep's direction
   std::vector<std::uint64_t> bits_;       // membership, row-major, rows padded to words
   std::vector<std::uint32_t> row_count_;  // members per row
-  std::vector<std::uint16_t> idle_;       // consecutive idle visits, per node
+  Idle idle_;                             // consecutive idle visits of the members
 };
 
+template <class Idle>
 template <class Visit>
-std::size_t ActiveSet::sweep(std::size_t max_visits, Visit&& visit) {
+std::size_t BasicActiveSet<Idle>::sweep(std::size_t max_visits, Visit&& visit) {
   const unsigned pass = sweeps_++;
   const bool y_up = pass % 2 == 0;
   const bool x_up = (pass / 2) % 2 == 0;
@@ -125,5 +152,8 @@ std::size_t ActiveSet::sweep(std::size_t max_visits, Visit&& visit) {
   }
   return visits;
 }
+
+using ActiveSet = BasicActiveSet<DenseIdleCounts>;
+extern template class BasicActiveSet<DenseIdleCounts>;
 
 }  // namespace sb::grid

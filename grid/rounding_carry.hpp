@@ -33,6 +33,8 @@ class RoundingCarry {
   }
   // Volume (m^3) owed to the surface by rounding: true volume = stored volume + m3().
   double m3() const { return m3_; }
+  // For kernels that settle the carry themselves (erosion_kernel.hpp).
+  double& m3() { return m3_; }
 
  private:
   double m3_ = 0.0;

@@ -45,7 +45,10 @@ struct SparseHeights<Real>::Tree {
 
 template <class Real>
 SparseHeights<Real>::SparseHeights(const GridLayout& layout, const std::function<double(const Vec2&)>& initial)
-    : layout_(layout), blocks_x_((layout.nx + kBlock - 1) / kBlock), blocks_y_((layout.ny + kBlock - 1) / kBlock) {
+    : layout_(layout),
+      row_reciprocal_(~std::uint64_t{0} / layout.nx + 1),
+      blocks_x_((layout.nx + kBlock - 1) / kBlock),
+      blocks_y_((layout.ny + kBlock - 1) / kBlock) {
   const std::size_t block_count = blocks_x_ * blocks_y_;
   // Every block's heights, in voxel order; a block overhanging the grid repeats its first
   // node in the voxels outside it. Plain rounding: the initial volume is what is stored.

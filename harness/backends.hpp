@@ -10,7 +10,7 @@
 
 namespace sb {
 
-std::vector<std::string> backend_names();  // {"tin", "grid"}
+std::vector<std::string> backend_names();  // {"tin", "grid", "sparse"}
 // Throws InputError for an unknown name.
 std::unique_ptr<Terrain> make_terrain(const std::string& backend, const Scene& scene, const HeightField& initial);
 
