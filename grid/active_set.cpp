@@ -25,7 +25,7 @@ BasicActiveSet<Idle>::BasicActiveSet(std::size_t nx, std::size_t ny, int idle_pa
       idle_passes_(static_cast<std::uint16_t>(idle_passes)),
       bits_(words_per_row_ * ny, 0),
       row_count_(ny, 0),
-      idle_(nx, ny, words_per_row_) {
+      idle_(nx, ny, words_per_row_, idle_passes_) {
   if (idle_passes < 1 || idle_passes > 32767)
     throw std::invalid_argument("ActiveSet: idle_passes must be in [1, 32767]");
 }
@@ -58,6 +58,6 @@ void BasicActiveSet<Idle>::check(std::vector<std::string>& problems) const {
 }
 
 template class BasicActiveSet<DenseIdleCounts>;
-template class BasicActiveSet<PagedIdleCounts>;
+template class BasicActiveSet<BitPlaneIdleCounts>;
 
 }  // namespace sb::grid

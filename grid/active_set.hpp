@@ -4,9 +4,9 @@
 //
 // Membership is one bit per node, rows padded to whole 64-bit words, plus a member count
 // per row; each member also keeps a 16-bit count of consecutive idle visits (a non-member's
-// count is 0), held by the Idle policy: DenseIdleCounts, one per node (the dense grid), or
-// PagedIdleCounts, a page of 64 counts per bitmap word that holds a member (the sparse
-// grid, sparse_idle_counts.hpp). The policy changes only where the counts live. A node that
+// count is 0), held by the Idle policy: DenseIdleCounts, 16 bits per node (the dense grid),
+// or BitPlaneIdleCounts, as many bits per node as idle_passes needs (the sparse grid,
+// sparse_idle_counts.hpp). The policy changes only where the counts live. A node that
 // transferred, and its 3 x 3 block, become members with a fresh idle count; an idle node
 // stays until it has been idle `idle_passes` times in a row.
 //
@@ -19,7 +19,7 @@
 // number, so the same input gives the same sequence of visits.
 //
 // Memory: 1 bit per node and 4 bytes per row, plus the counts: 2 bytes per node (dense),
-// or 128 bytes per word with members at the high-water mark and 4 bytes per word (paged).
+// or bit_width(idle_passes - 1) bits per node (bit planes; 1 bit for the default 2).
 // activate_block / idle are O(1); a sweep is O(rows + words of rows with members + visits).
 #include <bit>
 #include <cstddef>
@@ -32,11 +32,16 @@ namespace sb::grid {
 // One idle count per node.
 class DenseIdleCounts {
  public:
-  DenseIdleCounts(std::size_t nx, std::size_t ny, std::size_t /*words_per_row*/) : nx_(nx), counts_(nx * ny, 0) {}
-  std::uint16_t& at(std::size_t ix, std::size_t iy) { return counts_[iy * nx_ + ix]; }
+  DenseIdleCounts(std::size_t nx, std::size_t ny, std::size_t /*words_per_row*/, std::uint16_t /*idle_passes*/)
+      : nx_(nx), counts_(nx * ny, 0) {}
+  // One more idle visit; true (and the count back to 0) when it makes idle_passes.
+  bool count_up(std::size_t ix, std::size_t iy, std::uint16_t idle_passes) {
+    std::uint16_t& count = counts_[iy * nx_ + ix];
+    if (++count < idle_passes) return false;
+    count = 0;
+    return true;
+  }
   void reset(std::size_t ix, std::size_t iy) { counts_[iy * nx_ + ix] = 0; }
-  void word_filled(std::size_t /*word*/) {}   // a bitmap word got its first member
-  void word_emptied(std::size_t /*word*/) {}  // a bitmap word lost its last member
   std::size_t bytes() const { return counts_.capacity() * sizeof(std::uint16_t); }
   // Counts below idle_passes, zero for non-members.
   void check(const std::vector<std::uint64_t>& bits, std::size_t words_per_row, std::uint16_t idle_passes,
@@ -69,13 +74,9 @@ class BasicActiveSet {
   }
   // Node (ix, iy) was visited and stayed put: it leaves after idle_passes such visits in a row.
   void idle(std::size_t ix, std::size_t iy) {
-    std::uint16_t& count = idle_.at(ix, iy);
-    if (++count < idle_passes_) return;
-    count = 0;
-    const std::size_t word = iy * words_per_row_ + ix / 64;
-    std::uint64_t& w = bits_[word];
+    if (!idle_.count_up(ix, iy, idle_passes_)) return;
+    std::uint64_t& w = bits_[iy * words_per_row_ + ix / 64];
     w &= ~(std::uint64_t{1} << (ix % 64));
-    if (w == 0) idle_.word_emptied(word);
     --row_count_[iy];
     --size_;
   }
@@ -107,7 +108,6 @@ class BasicActiveSet {
       const std::uint64_t mask =
           (hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & ~((std::uint64_t{1} << lo) - 1);
       const int added = std::popcount(mask & ~row[wi]);
-      if (added > 0 && row[wi] == 0) idle_.word_filled(y * words_per_row_ + wi);
       row[wi] |= mask;
       row_count_[y] += static_cast<std::uint32_t>(added);
       size_ += static_cast<std::size_t>(added);

@@ -89,8 +89,8 @@ SparseHeights<Real>::SparseHeights(const GridLayout& layout, const std::function
       }
     }
   openvdb::tools::prune(tree_->tree, Real(0), /*threaded=*/false);
-  blocks_.resize(block_count);
-  dirty_flag_.assign(block_count, 0);
+  data_.resize(block_count);
+  state_.assign(block_count, 0);
   refresh_table();
 }
 
@@ -100,15 +100,32 @@ SparseHeights<Real>::~SparseHeights() = default;
 template <class Real>
 void SparseHeights<Real>::refresh_table() {
   openvdb::tree::ValueAccessor<const typename Tree::Type, /*IsSafe=*/false> acc(tree_->tree);
+  // One shared buffer per distinct tile height, found by its bits.
+  std::vector<std::unique_ptr<Real[]>> buffers;
+  std::map<std::conditional_t<sizeof(Real) == 8, std::uint64_t, std::uint32_t>, Real*> by_height;
+  const auto tile_buffer = [&](Real z) {
+    Real*& buffer = by_height[std::bit_cast<typename decltype(by_height)::key_type>(z)];
+    if (!buffer) {
+      buffers.push_back(std::make_unique<Real[]>(kBlock * kBlock));
+      buffer = buffers.back().get();
+      std::fill(buffer, buffer + kBlock * kBlock, z);
+    }
+    return buffer;
+  };
   for (std::size_t by = 0; by < blocks_y_; ++by)
     for (std::size_t bx = 0; bx < blocks_x_; ++bx) {
       const openvdb::Coord o = Tree::origin(bx, by);
-      Block& b = blocks_[by * blocks_x_ + bx];
+      const std::size_t b = by * blocks_x_ + bx;
       // The table writes through the leaf's buffer; the const accessor only finds it.
-      const auto* leaf = acc.probeConstLeaf(o);
-      b.data = leaf ? const_cast<Real*>(leaf->buffer().data()) : nullptr;
-      b.uniform = leaf ? Real(0) : acc.getValue(o);
+      if (const auto* leaf = acc.probeConstLeaf(o)) {
+        data_[b] = const_cast<Real*>(leaf->buffer().data());
+        state_[b] |= kLeaf;
+      } else {
+        data_[b] = tile_buffer(acc.getValue(o));
+        state_[b] &= static_cast<std::uint8_t>(~kLeaf);
+      }
     }
+  tile_buffers_ = std::move(buffers);
 }
 
 template <class Real>
@@ -116,8 +133,8 @@ Real* SparseHeights<Real>::materialise(std::size_t block) {
   const std::size_t bx = block % blocks_x_, by = block / blocks_x_;
   // touchLeaf fills the new leaf with the tile's value.
   Real* data = tree_->tree.touchLeaf(Tree::origin(bx, by))->buffer().data();
-  blocks_[block].data = data;
-  blocks_[block].uniform = Real(0);
+  data_[block] = data;
+  state_[block] |= kLeaf;
   return data;
 }
 
@@ -125,9 +142,9 @@ template <class Real>
 std::size_t SparseHeights<Real>::prune() {
   std::size_t pruned = 0;
   for (std::uint32_t b : dirty_) {
-    dirty_flag_[b] = 0;
-    Real* data = blocks_[b].data;
-    if (!data) continue;
+    state_[b] &= static_cast<std::uint8_t>(~kDirty);
+    if (!(state_[b] & kLeaf)) continue;
+    Real* data = data_[b];
     const std::size_t bx = b % blocks_x_, by = b / blocks_x_;
     const Real first = data[0];  // node (8 bx, 8 by): always inside the grid
     bool uniform = true;
@@ -156,17 +173,24 @@ SparseTreeCounts SparseHeights<Real>::counts() const {
   c.leaves = tree_->tree.leafCount();
   c.internal = tree_->tree.nonLeafCount() - 1;  // without the root
   c.root_entries = tree_->tree.root().getTableSize();
-  for (const Block& b : blocks_)
-    if (!b.data && !same_bits(b.uniform, background_)) ++c.tile_blocks;
+  for (std::size_t b = 0; b < data_.size(); ++b)
+    if (!(state_[b] & kLeaf) && !same_bits(data_[b][0], background_)) ++c.tile_blocks;
   return c;
 }
 
 template <class Real>
-std::size_t SparseHeights<Real>::bytes() const {
+std::size_t SparseHeights<Real>::tree_bytes() const {
   const SparseTreeCounts c = counts();
-  const std::size_t tree = sizeof(Tree) + c.leaves * (sizeof(typename Tree::Leaf) + kBlock * kBlock * sizeof(Real)) +
-                           c.internal * sizeof(typename Tree::Internal) + c.root_entries * Tree::kRootEntryBytes;
-  return tree + blocks_.capacity() * sizeof(Block) + dirty_flag_.capacity() + dirty_.capacity() * sizeof(std::uint32_t);
+  return sizeof(Tree) + c.leaves * (sizeof(typename Tree::Leaf) + kBlock * kBlock * sizeof(Real)) +
+         c.internal * sizeof(typename Tree::Internal) + c.root_entries * Tree::kRootEntryBytes;
+}
+
+template <class Real>
+std::size_t SparseHeights<Real>::bytes() const {
+  const std::size_t tiles = tile_buffers_.capacity() * sizeof(std::unique_ptr<Real[]>) +
+                            tile_buffers_.size() * kBlock * kBlock * sizeof(Real);
+  return tree_bytes() + tiles + data_.capacity() * sizeof(Real*) + state_.capacity() +
+         dirty_.capacity() * sizeof(std::uint32_t);
 }
 
 template <class Real>
@@ -187,23 +211,26 @@ void SparseHeights<Real>::check(std::vector<std::string>& problems) const {
     }
   if (wrong > 3) problems.push_back("sparse: " + std::to_string(wrong) + " nodes disagree with the tree in all");
   std::size_t listed = 0;
-  for (std::size_t b = 0; b < blocks_.size(); ++b) {
-    const Block& blk = blocks_[b];
+  for (std::size_t b = 0; b < data_.size(); ++b) {
     const auto* leaf = acc.probeConstLeaf(Tree::origin(b % blocks_x_, b / blocks_x_));
-    if ((leaf ? leaf->buffer().data() : nullptr) != blk.data)
-      problems.push_back("sparse: block " + std::to_string(b) + " table pointer does not match its leaf");
-    listed += blk.data ? 1 : 0;
+    if (leaf ? (leaf->buffer().data() != data_[b] || !(state_[b] & kLeaf)) : (state_[b] & kLeaf) != 0)
+      problems.push_back("sparse: block " + std::to_string(b) + " table entry does not match its leaf");
+    if (!leaf)
+      for (std::size_t v = 0; v < kBlock * kBlock; ++v)
+        if (!same_bits(data_[b][v], data_[b][0]))
+          problems.push_back("sparse: tile block " + std::to_string(b) + " reads a buffer that is not uniform");
+    listed += leaf ? 1 : 0;
   }
   if (listed != tree_->tree.leafCount())
     problems.push_back("sparse: " + std::to_string(tree_->tree.leafCount()) + " leaves, " + std::to_string(listed) +
                        " inside the grid");
-  std::vector<std::uint8_t> in_list(blocks_.size(), 0);
+  std::vector<std::uint8_t> in_list(data_.size(), 0);
   for (std::uint32_t b : dirty_) {
-    if (b >= blocks_.size() || in_list[b]++)
+    if (b >= data_.size() || in_list[b]++)
       problems.push_back("sparse: dirty list entry " + std::to_string(b) + " out of range or repeated");
   }
-  for (std::size_t b = 0; b < blocks_.size(); ++b)
-    if (dirty_flag_[b] != in_list[b])
+  for (std::size_t b = 0; b < data_.size(); ++b)
+    if (((state_[b] & kDirty) != 0) != (in_list[b] != 0))
       problems.push_back("sparse: block " + std::to_string(b) + " dirty flag disagrees with the list");
 }
 

@@ -21,18 +21,20 @@
 // value written equals it. prune() turns blocks written since the last call whose nodes are
 // all equal (bit for bit) back into tiles; the terrain calls it when erosion settles.
 //
-// Access: a table with one entry per block (a pointer to its leaf's voxel buffer, or null
-// and the block's tile value), as tools::LeafManager keeps leaf pointers, makes z() and
-// set() O(1) without a tree descent: a few shifts, one load, one branch. The table is
-// rebuilt from the tree after construction and after a prune that changed something.
+// Access: a table with one pointer per block, as tools::LeafManager keeps leaf pointers --
+// to its leaf's voxel buffer, or for a tile to a shared buffer of 64 copies of the tile's
+// height -- makes z() O(1) without a tree descent or a branch (a few shifts, two loads),
+// and set() one branch more. The table is rebuilt from the tree after construction and
+// after a prune that changed something.
 //
 // Memory (stats().bytes counts exactly this, checked against the allocator in
 // tests/unit/sparse_heights_test.cpp; OpenVDB's memUsage() is the tree part without the
 // root map's node headers):
 //   per node of a block with a leaf:  sizeof(Real) + 40/64 bytes
 //                                     (double: 8.625, float: 4.625 bytes/node)
-//   per node of a tile or background block:  0.27 bytes
-//                                     (its table entry, 16 bytes, and dirty flag, per 64 nodes)
+//   per node of a tile or background block:  0.14 bytes
+//                                     (its table pointer and state byte, 9 bytes per 64 nodes)
+//   per distinct tile height (the background included): 64 * sizeof(Real) bytes
 //   per internal node (32 x 128 nodes) holding a leaf or a non-background tile: 544 bytes,
 //   plus its root map entry (64 float, 72 double); the tree object 1232 bytes; the list of
 //   blocks written since the last prune, 4 bytes each.
@@ -77,8 +79,7 @@ class SparseHeights {
 
   const GridLayout& layout() const { return layout_; }
   double z(std::size_t ix, std::size_t iy) const {
-    const Block& b = blocks_[block_index(ix, iy)];
-    return static_cast<double>(b.data ? b.data[voxel_offset(ix, iy)] : b.uniform);
+    return static_cast<double>(data_[block_index(ix, iy)][voxel_offset(ix, iy)]);
   }
 
   // Stores `target` (m) at node k; with float storage the rounding error is carried on.
@@ -117,6 +118,8 @@ class SparseHeights {
   Real background() const { return background_; }
   // Model bytes: the tree's nodes and map entries, the block table, the dirty list.
   std::size_t bytes() const;
+  // The tree's part of bytes(): its nodes and root map entries.
+  std::size_t tree_bytes() const;
   // OpenVDB's own estimate, Tree::memUsage().
   std::size_t tree_mem_usage() const;
   SparseTreeCounts counts() const;
@@ -131,10 +134,10 @@ class SparseHeights {
   }
 
  private:
-  struct Block {
-    Real* data = nullptr;  // the leaf's voxel buffer; null for a tile or the background
-    Real uniform = 0;      // the tile's height when data is null
-  };
+  // Block state bits.
+  static constexpr std::uint8_t kLeaf = 1;   // data_ points into the block's own leaf
+  static constexpr std::uint8_t kDirty = 2;  // written since the last prune (listed in dirty_)
+
   struct Tree;  // the OpenVDB tree, kept out of this header (sparse_heights.cpp)
 
   static bool same_bits(Real a, Real b) {
@@ -151,14 +154,14 @@ class SparseHeights {
   }
   void store(std::size_t ix, std::size_t iy, Real stored) {
     const std::size_t bi = block_index(ix, iy);
-    Real* data = blocks_[bi].data;
-    if (!data) {
-      if (same_bits(stored, blocks_[bi].uniform)) return;
-      data = materialise(bi);
+    std::uint8_t& state = state_[bi];
+    if (!(state & kLeaf)) {
+      if (same_bits(stored, data_[bi][0])) return;
+      materialise(bi);
     }
-    data[voxel_offset(ix, iy)] = stored;
-    if (!dirty_flag_[bi]) {
-      dirty_flag_[bi] = 1;
+    data_[bi][voxel_offset(ix, iy)] = stored;
+    if (!(state & kDirty)) {
+      state |= kDirty;
       dirty_.push_back(static_cast<std::uint32_t>(bi));
     }
   }
@@ -170,9 +173,13 @@ class SparseHeights {
   std::size_t blocks_x_ = 0, blocks_y_ = 0;
   Real background_ = 0;
   std::unique_ptr<Tree> tree_;
-  std::vector<Block> blocks_;
-  std::vector<std::uint8_t> dirty_flag_;  // per block: listed in dirty_
-  std::vector<std::uint32_t> dirty_;      // blocks written since the last prune
+  // Per block: its 64 heights in voxel order -- its leaf's buffer, or for a tile (or the
+  // background) the buffer of 64 copies of its height shared by every block at that
+  // height -- and its state bits.
+  std::vector<Real*> data_;
+  std::vector<std::uint8_t> state_;
+  std::vector<std::unique_ptr<Real[]>> tile_buffers_;  // one per distinct tile height
+  std::vector<std::uint32_t> dirty_;                   // blocks written since the last prune
   RoundingCarry<Real> carry_;
 };
 

@@ -1,13 +1,12 @@
 #pragma once
-// PagedIdleCounts: the active set's idle counts (active_set.hpp's Idle policy) for the
-// sparse grid, held only for the 64-node words of the membership bitmap that have a member.
+// BitPlaneIdleCounts: the active set's idle counts (active_set.hpp's Idle policy) for the
+// sparse grid, as bit planes beside the membership bitmap: a count below idle_passes needs
+// P = bit_width(idle_passes - 1) bits, so each 64-node word of the bitmap has P words of
+// counts, bit p of node b's count in bit b of plane p. The default idle_passes = 2 needs one
+// bit per node (the dense policy: 16); idle_passes = 1 none.
 //
-// A word's first member takes a page of 64 zeroed counts from a pool (a free list, so that
-// a word that empties and fills again does not go back to the allocator); its last member
-// leaving returns the page (all counts of non-members are zero, so it is clean). Memory:
-// 4 bytes per bitmap word (64 nodes) for the page index, plus 128 bytes per page at the
-// high-water mark of words with members, plus 4 bytes per free-list entry. All O(1).
-#include <array>
+// Memory: P / 8 bytes per node (rows padded to 64 nodes). count_up / reset O(P).
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -17,78 +16,53 @@
 
 namespace sb::grid {
 
-class PagedIdleCounts {
+class BitPlaneIdleCounts {
  public:
-  PagedIdleCounts(std::size_t /*nx*/, std::size_t ny, std::size_t words_per_row)
-      : words_per_row_(words_per_row), page_of_word_(words_per_row * ny, kNone) {}
+  BitPlaneIdleCounts(std::size_t /*nx*/, std::size_t ny, std::size_t words_per_row, std::uint16_t idle_passes)
+      : words_per_row_(words_per_row),
+        planes_(idle_passes > 1 ? std::bit_width(static_cast<unsigned>(idle_passes - 1)) : 0),
+        bits_(words_per_row * ny * planes_, 0) {}
 
-  std::uint16_t& at(std::size_t ix, std::size_t iy) {
-    return pages_[page_of_word_[iy * words_per_row_ + ix / 64]][ix % 64];
+  // One more idle visit; true (and the count back to 0) when it makes idle_passes.
+  bool count_up(std::size_t ix, std::size_t iy, std::uint16_t idle_passes) {
+    std::uint64_t* w = bits_.data() + (iy * words_per_row_ + ix / 64) * planes_;
+    const unsigned b = ix % 64;
+    unsigned count = 0;
+    for (unsigned p = 0; p < planes_; ++p) count |= static_cast<unsigned>((w[p] >> b) & 1u) << p;
+    if (++count >= idle_passes) count = 0;
+    for (unsigned p = 0; p < planes_; ++p)
+      w[p] = (w[p] & ~(std::uint64_t{1} << b)) | (static_cast<std::uint64_t>((count >> p) & 1u) << b);
+    return count == 0;
   }
-  // A word without a page has only zero counts.
   void reset(std::size_t ix, std::size_t iy) {
-    const std::uint32_t page = page_of_word_[iy * words_per_row_ + ix / 64];
-    if (page != kNone) pages_[page][ix % 64] = 0;
+    std::uint64_t* w = bits_.data() + (iy * words_per_row_ + ix / 64) * planes_;
+    for (unsigned p = 0; p < planes_; ++p) w[p] &= ~(std::uint64_t{1} << (ix % 64));
   }
-  void word_filled(std::size_t word) {
-    if (free_.empty()) {
-      page_of_word_[word] = static_cast<std::uint32_t>(pages_.size());
-      pages_.emplace_back();  // value-initialised: zeros
-    } else {
-      page_of_word_[word] = free_.back();
-      free_.pop_back();
-    }
-  }
-  void word_emptied(std::size_t word) {
-    free_.push_back(page_of_word_[word]);
-    page_of_word_[word] = kNone;
-  }
-  std::size_t bytes() const {
-    return page_of_word_.capacity() * sizeof(std::uint32_t) + pages_.capacity() * sizeof(Page) +
-           free_.capacity() * sizeof(std::uint32_t);
-  }
-  // Words with members have a page and the other words none; counts below idle_passes,
-  // zero for non-members and in free pages.
-  void check(const std::vector<std::uint64_t>& bits, std::size_t words_per_row, std::uint16_t idle_passes,
+  std::size_t bytes() const { return bits_.capacity() * sizeof(std::uint64_t); }
+  // Counts below idle_passes, zero for non-members. O(nodes * P).
+  void check(const std::vector<std::uint64_t>& members, std::size_t words_per_row, std::uint16_t idle_passes,
              std::vector<std::string>& problems) const {
-    std::vector<std::uint8_t> used(pages_.size(), 0);
-    for (std::size_t w = 0; w < bits.size(); ++w) {
-      const std::uint32_t page = page_of_word_[w];
-      if ((bits[w] != 0) != (page != kNone) || (page != kNone && page >= pages_.size())) {
-        problems.push_back("active set: bitmap word " + std::to_string(w) +
-                           (bits[w] ? " has members but no page" : " has a page but no members"));
-        continue;
+    for (std::size_t word = 0; word < members.size(); ++word)
+      for (unsigned b = 0; b < 64; ++b) {
+        unsigned count = 0;
+        for (unsigned p = 0; p < planes_; ++p)
+          count |= static_cast<unsigned>((bits_[word * planes_ + p] >> b) & 1u) << p;
+        const bool member = (members[word] >> b) & 1u;
+        if (count >= idle_passes || (!member && count != 0))
+          problems.push_back("active set: node " + std::to_string(b + 64 * (word % words_per_row)) + " of row " +
+                             std::to_string(word / words_per_row) + " idle count " + std::to_string(count) +
+                             (member ? " >= idle_passes" : " but not a member"));
       }
-      if (page == kNone) continue;
-      if (used[page]++) problems.push_back("active set: page " + std::to_string(page) + " used twice");
-      for (std::size_t b = 0; b < 64; ++b) {
-        const std::uint16_t c = pages_[page][b];
-        if (c >= idle_passes || (!((bits[w] >> b) & 1u) && c != 0))
-          problems.push_back("active set: node " + std::to_string(b) + " of word " + std::to_string(w) + " (row " +
-                             std::to_string(w / words_per_row) + ") has idle count " + std::to_string(c));
-      }
-    }
-    for (std::uint32_t page : free_) {
-      if (page >= pages_.size() || used[page]++) {
-        problems.push_back("active set: free page " + std::to_string(page) + " out of range or in use");
-        continue;
-      }
-      for (std::uint16_t c : pages_[page])
-        if (c != 0) problems.push_back("active set: free page " + std::to_string(page) + " not clean");
-    }
   }
 
  private:
-  using Page = std::array<std::uint16_t, 64>;
-  static constexpr std::uint32_t kNone = 0xffffffffu;
   std::size_t words_per_row_;
-  std::vector<std::uint32_t> page_of_word_;  // kNone: no member in the word
-  std::vector<Page> pages_;
-  std::vector<std::uint32_t> free_;
+  unsigned planes_;
+  std::vector<std::uint64_t> bits_;  // word-major: the planes of bitmap word w at [w * planes_, ...)
 };
 
-// The sparse grid's active set: the same ordered sweeps, its counts paged.
-using SparseActiveSet = BasicActiveSet<PagedIdleCounts>;
-extern template class BasicActiveSet<PagedIdleCounts>;
+// The sparse grid's active set: the same ordered sweeps, its counts in bit planes.
+using SparseActiveSet = BasicActiveSet<BitPlaneIdleCounts>;
+extern template class BasicActiveSet<BitPlaneIdleCounts>;
 
 }  // namespace sb::grid

@@ -171,14 +171,13 @@ TYPED_TEST(SparseHeightsTest, BytesMatchTheAllocatorAndOpenVdbsMemUsage) {
   const auto held = [&] { return static_cast<std::size_t>(::sb::test::live_heap_bytes() - before); };
   const GridLayout g = layout_101();
   auto h = std::make_unique<SparseHeights<TypeParam>>(g, bed);
-  // OpenVDB's estimate leaves out the root map's nodes and counts the root node twice.
+  // OpenVDB's estimate leaves out the root map's nodes (64 or 72 bytes each) and 4 bytes of
+  // each internal node (its transient data), and counts the root node (72 bytes) twice.
   const auto expect_mem_usage_close = [&] {
-    const SparseTreeCounts c = h->counts();
-    const std::size_t table = 13 * 13 * (2 * sizeof(void*) + 1);
     const std::size_t root_entry = sizeof(TypeParam) == 8 ? 72 : 64;
-    const long long unexplained = static_cast<long long>(h->bytes()) - static_cast<long long>(h->tree_mem_usage()) -
-                                  static_cast<long long>(table + c.root_entries * root_entry);
-    EXPECT_LE(std::abs(unexplained), 512) << "bytes " << h->bytes() << " memUsage " << h->tree_mem_usage();
+    const SparseTreeCounts c = h->counts();
+    EXPECT_EQ(h->tree_bytes() + 72, h->tree_mem_usage() + c.root_entries * root_entry + 4 * c.internal)
+        << "bytes " << h->bytes() << " memUsage " << h->tree_mem_usage();
   };
   EXPECT_EQ(held(), sizeof(SparseHeights<TypeParam>) + h->bytes());
   expect_mem_usage_close();
