@@ -16,7 +16,7 @@
 #include "common/haptics/shared_pose_device.hpp"
 #include "common/height_field.hpp"
 #include "common/scene.hpp"
-#include "harness/backends.hpp"
+#include "harness/run/backends.hpp"
 #include "tin/tin_terrain.hpp"
 
 namespace {

@@ -8,9 +8,9 @@
 
 #include <cmath>
 
-#include "harness/render.hpp"
-#include "harness/render_frame.hpp"
-#include "harness/render_mesh.hpp"
+#include "harness/render/frame.hpp"
+#include "harness/render/mesh.hpp"
+#include "harness/render/renderer.hpp"
 
 namespace {
 

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <cstring>
 
-#include "harness/backends.hpp"
-#include "harness/runner.hpp"
+#include "harness/run/backends.hpp"
+#include "harness/run/runner.hpp"
 
 namespace {
 

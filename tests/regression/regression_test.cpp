@@ -11,9 +11,9 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
-#include "harness/backends.hpp"
-#include "harness/runner.hpp"
-#include "harness/summary.hpp"
+#include "harness/run/backends.hpp"
+#include "harness/run/runner.hpp"
+#include "harness/run/summary.hpp"
 
 namespace sb {
 namespace {

@@ -19,8 +19,8 @@
 #include "common/height_field.hpp"
 #include "common/input_error.hpp"
 #include "common/scene.hpp"
-#include "harness/export.hpp"
-#include "harness/render_mesh.hpp"
+#include "harness/io/export.hpp"
+#include "harness/render/mesh.hpp"
 #include "harness_test_support.hpp"
 
 namespace sb {

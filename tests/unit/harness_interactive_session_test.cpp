@@ -14,10 +14,10 @@
 
 #include "common/haptics/replay_device.hpp"
 #include "common/input_error.hpp"
-#include "harness/backends.hpp"
-#include "harness/interactive_device.hpp"
-#include "harness/interactive_sim.hpp"
-#include "harness/session_file.hpp"
+#include "harness/interactive/device.hpp"
+#include "harness/interactive/sim.hpp"
+#include "harness/io/session_file.hpp"
+#include "harness/run/backends.hpp"
 #include "harness_test_support.hpp"
 
 namespace sb {

@@ -18,7 +18,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
-#include "harness/session_file.hpp"
+#include "harness/io/session_file.hpp"
 
 namespace sb {
 namespace {

@@ -15,12 +15,12 @@
 #include <iterator>
 #include <string>
 
-#include "harness/compare_pictures.hpp"
-#include "harness/render.hpp"
-#include "harness/render_colour.hpp"
-#include "harness/render_font.hpp"
-#include "harness/render_frame.hpp"
-#include "harness/render_mesh.hpp"
+#include "harness/figures/compare_pictures.hpp"
+#include "harness/figures/font.hpp"
+#include "harness/render/colour.hpp"
+#include "harness/render/frame.hpp"
+#include "harness/render/mesh.hpp"
+#include "harness/render/renderer.hpp"
 #include "harness_test_support.hpp"
 
 namespace sb {

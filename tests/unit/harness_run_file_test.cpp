@@ -3,7 +3,7 @@
 #include <filesystem>
 
 #include "common/input_error.hpp"
-#include "harness/run_file.hpp"
+#include "harness/io/run_file.hpp"
 
 namespace sb {
 namespace {

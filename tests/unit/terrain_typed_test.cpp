@@ -13,7 +13,7 @@
 #include "common/height_field.hpp"
 #include "common/scene.hpp"
 #include "common/schedule.hpp"
-#include "harness/backends.hpp"
+#include "harness/run/backends.hpp"
 
 namespace sb {
 namespace {

@@ -1,8 +1,8 @@
 // Inputs found by the stamp fuzzer (tests/fuzz/stamp_fuzz.cpp) that once broke the TIN.
 #include <gtest/gtest.h>
 
-#include "harness/backends.hpp"
-#include "harness/runner.hpp"
+#include "harness/run/backends.hpp"
+#include "harness/run/runner.hpp"
 
 namespace sb {
 namespace {

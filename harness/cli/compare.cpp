@@ -1,0 +1,140 @@
+// `sandbench compare SCENE [--backends tin,grid] [--out DIR] [--json] [--set k=v ...]`:
+// the same schedule on each back-end (or back-end variant), a table, the summaries and pictures.
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+
+#include "common/atomic_file.hpp"
+#include "common/input_error.hpp"
+#include "harness/cli/commands.hpp"
+#include "harness/figures/compare_pictures.hpp"
+#include "harness/io/run_file.hpp"
+#include "harness/run/backends.hpp"
+#include "harness/run/variant.hpp"
+
+namespace sb::cli {
+
+namespace {
+struct CompareOptions {
+  std::string scene;
+  std::string backends;
+  std::string out;
+  bool json = false;
+  std::vector<std::string> overrides;
+};
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> parts;
+  std::stringstream in(s);
+  for (std::string part; std::getline(in, part, sep);)
+    if (!part.empty()) parts.push_back(part);
+  return parts;
+}
+
+std::string markdown_table(const std::vector<VariantRun>& runs) {
+  static const char* rows[] = {"stamps",
+                               "time_s.tool",
+                               "time_s.erosion",
+                               "time_s.simplify",
+                               "time_s.total",
+                               "step_ms.p50",
+                               "step_ms.p95",
+                               "step_ms.max",
+                               "memory_bytes",
+                               "memory_bytes_peak",
+                               "vertices",
+                               "triangles",
+                               "constrained_edges",
+                               "cells",
+                               "volume_initial",
+                               "volume_final",
+                               "volume_added",
+                               "volume_drift_rel",
+                               "max_slope_excess_deg"};
+  std::ostringstream t;
+  t << "| metric |";
+  for (const auto& r : runs) t << " " << r.run.label << " |";
+  t << "\n|---|";
+  for (std::size_t i = 0; i < runs.size(); ++i) t << "---:|";
+  t << "\n";
+  for (const char* row : rows) {
+    t << "| " << row << " |";
+    for (const auto& r : runs) {
+      const Json& v = r.summary.at(row);
+      std::ostringstream cell;
+      if (v.is_number_float())
+        cell << std::setprecision(6) << v.get<double>();
+      else
+        cell << v.dump();
+      t << " " << cell.str() << " |";
+    }
+    t << "\n";
+  }
+  return t.str();
+}
+
+void compare_command(const CompareOptions& o) {
+  PreparedScene prepared = prepare_scene(load_scene(o.scene, o.overrides));
+  std::vector<Variant> variants;
+  for (const auto& item : split(o.backends.empty() ? "tin,grid" : o.backends, ','))
+    variants.push_back(parse_variant(item));
+  if (variants.empty()) throw InputError("--backends is empty; give e.g. tin,grid");
+  const std::filesystem::path dir = o.out;
+  if (!dir.empty()) std::filesystem::create_directories(dir);
+
+  std::vector<VariantRun> runs;
+  for (const Variant& v : variants) runs.push_back(run_variant(v, prepared, /*show_progress=*/true));
+
+  Json report;
+  report["scene"] = prepared.scene.path;
+  report["stamps"] = prepared.schedule.stamps.size();
+  report["runs"] = Json::array();
+  for (const auto& r : runs) report["runs"].push_back(r.summary);
+  report["differences"] = Json::array();
+  for (std::size_t i = 1; i < runs.size(); ++i) {
+    const RasterDifference d = compare_rasters(runs[i].run.final_raster, runs[0].run.final_raster);
+    report["differences"].push_back({{"a", runs[i].run.label},
+                                     {"b", runs[0].run.label},
+                                     {"rmse_m", d.rmse_m},
+                                     {"max_abs_m", d.max_abs_m},
+                                     {"mean_m", d.mean_m}});
+  }
+
+  const std::string table = markdown_table(runs);
+  if (!dir.empty()) {
+    for (const auto& r : runs)
+      write_run_file(dir / default_run_path(o.scene, r.run.label).filename(), r.run, r.prepared, r.summary);
+    write_atomically(dir / "summary.json",
+                     [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << report.dump(2) << "\n"; });
+    write_atomically(dir / "table.md", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << table; });
+    std::vector<PictureRun> pictures;
+    for (const auto& r : runs)
+      pictures.push_back({r.run.label, &r.run.final_mesh, &r.run.initial_raster, &r.run.final_raster, &r.summary});
+    write_compare_pictures(dir, pictures);
+    std::cerr << "wrote " << dir.string() << "/{*.h5,summary.json,table.md,side_by_side.png"
+              << (runs.size() > 1 ? ",difference.png}\n" : "}\n");
+  }
+  if (o.json) {
+    std::cout << report.dump(2) << "\n";
+  } else {
+    std::cout << table;
+  }
+}
+}  // namespace
+
+void add_compare_command(CLI::App& app) {
+  auto opts = std::make_shared<CompareOptions>();
+  CLI::App* cmd = app.add_subcommand("compare", "Run the same schedule on several back-ends and compare them");
+  cmd->add_option("scene", opts->scene, "Scene file (TOML)")->required();
+  cmd->add_option("--backends", opts->backends,
+                  "Comma-separated back-ends or variants (default tin,grid), e.g. grid,grid:grid.storage=float");
+  cmd->add_option("--out", opts->out,
+                  "Directory for run files, summary.json, table.md, side_by_side.png and difference.png");
+  cmd->add_flag("--json", opts->json, "Print the report as JSON on stdout");
+  cmd->add_option("--set", opts->overrides, "Override a scene key: --set tool.radius_m=0.03")->take_all();
+  cmd->callback([opts] { compare_command(*opts); });
+}
+
+}  // namespace sb::cli

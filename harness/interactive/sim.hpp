@@ -1,0 +1,136 @@
+#pragma once
+// The interactive simulation thread. It owns the terrain (nobody else touches it) and loops:
+// read the servo's newest state; stamp when the tool penetrates the sand and has moved at
+// least the stroke spacing (or gone deeper) since the last stamp; erode within a per-step
+// budget; simplify; republish the height patch for the servo; every 1/30 s hand a mesh and
+// counters to the window. Controls from the window and the display snapshot go through a
+// mutex that the servo never sees. Optionally records the session (device samples drained
+// from the servo's queue, every stamp applied).
+#include <atomic>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "common/haptics/servo_loop.hpp"
+#include "harness/io/session_file.hpp"
+#include "harness/run/runner.hpp"
+
+namespace sb {
+
+struct SimControls {
+  Material material;
+  ToolSpec tool;
+  bool paused = false;
+  bool erosion = true;
+  bool simplify = true;
+  int erosion_passes = 4;               // per step
+  std::size_t erosion_updates = 20000;  // per step: element visits
+};
+
+// What the window shows; copied out under the mutex at display rate.
+struct SimStatus {
+  ModelStats stats;
+  double volume_m3 = 0.0, volume_initial_m3 = 0.0, volume_added_m3 = 0.0;
+  std::uint64_t steps = 0, stamps = 0, patches = 0;
+  double tool_ms = 0.0, erosion_ms = 0.0, simplify_ms = 0.0, patch_ms = 0.0;  // last working step
+  double step_ms_p50 = 0.0, step_ms_p95 = 0.0;                                // last 256 working steps
+  double tool_heading_rad = 0.0;                                              // footprint rotation of the current tool
+  bool recording = false;
+  std::size_t recorded_samples = 0, recorded_stamps = 0;
+  std::string message;  // e.g. "wrote session.csv"
+};
+
+// Whole-run figures for the statistics file.
+struct SimTotals {
+  std::uint64_t steps = 0, stamps = 0, patches = 0;
+  std::vector<double> step_ms;   // every working step: stamp + erode + simplify
+  std::vector<double> patch_ms;  // every publication
+  ModelStats final_stats;
+  double volume_initial_m3 = 0.0, volume_final_m3 = 0.0, volume_added_m3 = 0.0;
+};
+
+struct DisplayMesh {
+  std::uint64_t version = 0;
+  SurfaceMesh mesh;
+};
+
+class Simulation {
+ public:
+  // Publishes a first patch (at the domain's centre) and a first mesh before returning, so the
+  // servo and the window have something from their first tick and frame.
+  Simulation(const PreparedScene& prepared, std::unique_ptr<Terrain> terrain, haptics::PatchBuffer& patches,
+             haptics::ServoLoop& servo, std::string backend);
+  ~Simulation();
+
+  void start();
+  void stop();  // joins, then finishes a recording in progress (writes its file)
+
+  // Window thread.
+  SimControls controls() const;
+  void set_controls(const SimControls& c);
+  SimStatus status() const;
+  std::shared_ptr<const DisplayMesh> mesh() const;
+  // Recording into `file` (written when stopped, whole or not at all).
+  void start_recording(const std::filesystem::path& file);
+  void stop_recording();
+
+  // After stop().
+  SimTotals totals() const;
+  const Terrain& terrain() const { return *terrain_; }
+  std::string recording_error() const;  // empty when every recording was written
+
+ private:
+  void run();
+  void step();
+  bool maybe_stamp(const haptics::ServoState& s);
+  void publish_patch(const Vec2& centre);
+  void publish_display(bool force);
+  void drain_samples();
+  void begin_recording();
+  void end_recording();
+
+  const PreparedScene& prepared_;
+  std::unique_ptr<Terrain> terrain_;
+  haptics::PatchBuffer& patches_;
+  haptics::ServoLoop& servo_;
+  std::string backend_;
+
+  // Simulation thread only.
+  SimControls active_;
+  ErosionRule rule_;
+  haptics::ForceParams params_;
+  haptics::PatchLayout layout_;
+  std::uint64_t patch_version_ = 0;
+  Vec2 patch_centre_{0.0, 0.0};
+  bool have_stamp_ = false;
+  Vec2 last_stamp_xy_{0.0, 0.0};
+  double last_stamp_z_ = 0.0, last_stamp_t_ = 0.0, heading_rad_ = 0.0;
+  std::uint32_t generation_ = 0;
+  bool dirty_ = false;          // terrain changed since the last display snapshot
+  std::size_t active_set_ = 1;  // erosion active set after the last erode (1: unknown)
+  double last_display_s_ = -1.0;
+  std::vector<double> recent_ms_;  // ring of the last working steps
+  std::size_t recent_next_ = 0;
+  SimTotals totals_;
+  Session session_;
+  std::filesystem::path record_file_;
+  bool recording_ = false;
+  Stopwatch clock_;
+
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  std::atomic<bool> controls_changed_{false};
+  std::atomic<int> record_request_{0};  // 1 start, -1 stop
+
+  mutable std::mutex mutex_;  // guards the members below (never taken by the servo)
+  SimControls controls_;
+  SimStatus status_;
+  std::shared_ptr<const DisplayMesh> mesh_;
+  std::filesystem::path requested_file_;
+  std::string record_error_;
+};
+
+}  // namespace sb

@@ -1,0 +1,68 @@
+#include "harness/interactive/stats.hpp"
+
+#include <algorithm>
+#include <fstream>
+
+#include "common/atomic_file.hpp"
+#include "common/metrics.hpp"
+
+namespace sb {
+
+Json haptic_stats_json(const haptics::ServoStats& s, const haptics::DeviceLimits& limits, const SimTotals& sim,
+                       const InteractiveRunInfo& info) {
+  Json j;
+  j["servo_hz"] = s.servo_hz;
+  j["tick_us.p50"] = s.tick_us_p50;
+  j["tick_us.p99"] = s.tick_us_p99;
+  j["tick_us.max"] = s.tick_us_max;
+  j["missed_deadlines"] = s.missed_deadlines;
+  j["force_max_n"] = s.force_max_n;
+  // Extras beyond the contract.
+  j["force_limit_n"] = limits.max_force_n;
+  j["stiffness_limit_n_per_m"] = limits.max_stiffness_n_per_m;
+  j["device_force_max_n"] = info.device_force_max_n;
+  j["forces_clamped"] = s.forces_clamped;
+  j["forces_nonfinite"] = s.forces_nonfinite;
+  j["ticks"] = s.ticks;
+  j["duration_s"] = s.duration_s;
+  j["late_us.p50"] = s.late_us_p50;
+  j["late_us.p99"] = s.late_us_p99;
+  j["late_us.max"] = s.late_us_max;
+  j["ticks_in_contact"] = s.ticks_in_contact;
+  j["ticks_without_pose"] = s.ticks_without_pose;
+  j["ticks_outside_patch"] = s.ticks_outside_patch;
+  j["samples_dropped"] = s.samples_dropped;
+  j["realtime"] = s.realtime;
+  j["sim.steps"] = sim.steps;
+  j["sim.stamps"] = sim.stamps;
+  j["sim.step_ms.p50"] = percentile(sim.step_ms, 0.5);
+  j["sim.step_ms.p95"] = percentile(sim.step_ms, 0.95);
+  j["sim.step_ms.max"] = sim.step_ms.empty() ? 0.0 : *std::max_element(sim.step_ms.begin(), sim.step_ms.end());
+  j["patches"] = sim.patches;
+  j["patch_ms.p50"] = percentile(sim.patch_ms, 0.5);
+  j["patch_ms.p95"] = percentile(sim.patch_ms, 0.95);
+  j["vertices"] = sim.final_stats.vertices;
+  j["triangles"] = sim.final_stats.triangles;
+  j["cells"] = sim.final_stats.cells;
+  j["memory_bytes"] = sim.final_stats.bytes;
+  j["volume_initial"] = sim.volume_initial_m3;
+  j["volume_final"] = sim.volume_final_m3;
+  j["volume_added"] = sim.volume_added_m3;
+  j["frames"] = info.frames;
+  j["fps"] = info.wall_s > 0.0 ? static_cast<double>(info.frames) / info.wall_s : 0.0;
+  j["backend"] = info.backend;
+  j["device"] = info.device;
+  j["scene"] = info.scene;
+  return j;
+}
+
+void write_json_file(const std::filesystem::path& file, const Json& json) {
+  write_atomically(file, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out << json.dump(2) << "\n";
+    out.flush();
+    if (!out) throw std::runtime_error("writing " + tmp.string() + " failed");
+  });
+}
+
+}  // namespace sb

@@ -1,0 +1,26 @@
+#pragma once
+// The haptic statistics file of `sandbench interactive --stats FILE`: the contract keys of
+// DESIGN.md (servo_hz, tick_us.p50, tick_us.p99, tick_us.max, missed_deadlines,
+// force_max_n) first, then the limits, the simulation's figures and bookkeeping.
+#include <filesystem>
+#include <string>
+
+#include "common/haptics/servo_loop.hpp"
+#include "harness/interactive/sim.hpp"
+#include "harness/run/summary.hpp"
+
+namespace sb {
+
+struct InteractiveRunInfo {
+  std::string scene, backend, device;
+  std::uint64_t frames = 0;
+  double wall_s = 0.0;               // window open time
+  double device_force_max_n = -1.0;  // as the device saw it (replay, mouse); < 0: unknown
+};
+
+Json haptic_stats_json(const haptics::ServoStats& servo, const haptics::DeviceLimits& limits, const SimTotals& sim,
+                       const InteractiveRunInfo& info);
+// Whole or not at all.
+void write_json_file(const std::filesystem::path& file, const Json& json);
+
+}  // namespace sb

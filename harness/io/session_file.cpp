@@ -1,0 +1,217 @@
+#include "harness/io/session_file.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "common/atomic_file.hpp"
+#include "common/haptics/csv_tables.hpp"
+#include "common/input_error.hpp"
+
+namespace sb {
+
+namespace {
+
+using haptics::csv_fail;
+using haptics::csv_index;
+using haptics::csv_number;
+using haptics::CsvFile;
+using haptics::CsvTable;
+
+const std::vector<std::string> kForceHeader{"t", "fx", "fy", "fz", "penetration_m"};
+const std::vector<std::string> kToolHeader{
+    "tool",    "shape",       "radius_m",         "size_x_m",       "size_y_m", "sides", "profile", "sphere_radius_m",
+    "depth_m", "rim_width_m", "rim_forward_bias", "pour_volume_m3", "polygon_m"};
+const std::vector<std::string> kStampHeader{"stamp",       "t",     "x",     "y",   "bottom_z",
+                                            "heading_rad", "dir_x", "dir_y", "tool"};
+
+std::string num(double v) {
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// A tool's row without its index.
+std::string tool_fields(const ToolSpec& t) {
+  std::string poly;
+  for (const Vec2& p : t.polygon_m) {
+    if (!poly.empty()) poly += ' ';
+    poly.append(num(p.x())).append(" ").append(num(p.y()));
+  }
+  return to_string(t.shape) + "," + num(t.radius_m) + "," + num(2.0 * t.half_size_m.x()) + "," +
+         num(2.0 * t.half_size_m.y()) + "," + std::to_string(t.sides) + "," + to_string(t.profile) + "," +
+         num(t.sphere_radius_m) + "," + num(t.depth_m) + "," + num(t.rim.width_m) + "," + num(t.rim.forward_bias) +
+         "," + num(t.pour_volume_m3) + "," + poly;
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ",") + x;
+  return s;
+}
+
+ToolSpec read_tool(const CsvFile& f, const CsvTable& t, std::size_t r) {
+  ToolSpec tool;
+  const std::string& shape = t.rows[r][1];
+  const int line = t.lines[r];
+  if (shape == "disk")
+    tool.shape = ToolShape::Disk;
+  else if (shape == "box")
+    tool.shape = ToolShape::Box;
+  else if (shape == "ellipse")
+    tool.shape = ToolShape::Ellipse;
+  else if (shape == "polygon")
+    tool.shape = ToolShape::Polygon;
+  else if (shape == "pour")
+    tool.shape = ToolShape::Pour;
+  else
+    csv_fail(f, line, "column shape = '" + shape + "' must be disk | box | ellipse | polygon | pour");
+  auto positive = [&](std::size_t col) {
+    const double v = csv_number(f, t, r, col);
+    if (!(v > 0.0)) csv_fail(f, line, "column " + t.header[col] + " = " + t.rows[r][col] + " must be > 0");
+    return v;
+  };
+  tool.radius_m = positive(2);
+  tool.half_size_m = Vec2(positive(3), positive(4)) / 2.0;
+  const std::size_t sides = csv_index(f, t, r, 5);
+  if (sides < 3 || sides > 4096) csv_fail(f, line, "column sides = " + t.rows[r][5] + " must be in [3, 4096]");
+  tool.sides = static_cast<int>(sides);
+  const std::string& profile = t.rows[r][6];
+  if (profile == "flat")
+    tool.profile = BottomProfile::Flat;
+  else if (profile == "sphere_cap")
+    tool.profile = BottomProfile::SphereCap;
+  else
+    csv_fail(f, line, "column profile = '" + profile + "' must be flat | sphere_cap");
+  tool.sphere_radius_m = positive(7);
+  tool.depth_m = csv_number(f, t, r, 8);
+  tool.rim.width_m = csv_number(f, t, r, 9);
+  tool.rim.forward_bias = csv_number(f, t, r, 10);
+  if (tool.rim.width_m < 0.0 || tool.rim.forward_bias < 0.0 || tool.rim.forward_bias > 1.0)
+    csv_fail(f, line, "columns rim_width_m >= 0 and rim_forward_bias in [0, 1] required");
+  tool.pour_volume_m3 = csv_number(f, t, r, 11);
+  if (tool.shape == ToolShape::Pour && !(tool.pour_volume_m3 > 0.0))
+    csv_fail(f, line, "column pour_volume_m3 must be > 0 for a pour tool");
+  std::istringstream poly(t.rows[r][12]);
+  std::vector<double> xy;
+  for (std::string w; poly >> w;) {
+    char* end = nullptr;
+    const double v = std::strtod(w.c_str(), &end);
+    if (*end != '\0' || !std::isfinite(v)) csv_fail(f, line, "column polygon_m: '" + w + "' is not a number");
+    xy.push_back(v);
+  }
+  if (xy.size() % 2 != 0) csv_fail(f, line, "column polygon_m must hold x y pairs");
+  for (std::size_t i = 0; i < xy.size(); i += 2) tool.polygon_m.emplace_back(xy[i], xy[i + 1]);
+  if (tool.shape == ToolShape::Polygon && (tool.polygon_m.size() < 3 || !is_simple_polygon(tool.polygon_m)))
+    csv_fail(f, line, "column polygon_m must be a simple polygon of at least 3 points");
+  return tool;
+}
+
+}  // namespace
+
+std::size_t session_tool_index(Session& session, const ToolSpec& tool) {
+  const std::string row = tool_fields(tool);
+  for (std::size_t i = 0; i < session.tools.size(); ++i)
+    if (tool_fields(session.tools[i]) == row) return i;
+  session.tools.push_back(tool);
+  return session.tools.size() - 1;
+}
+
+void write_session(const std::filesystem::path& file, const Session& s) {
+  write_atomically(file, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw InputError("--record " + file.string() + ": cannot write");
+    out << "# sandbench session 1\n";
+    if (!s.scene.empty()) out << "# scene: " << s.scene << "\n";
+    if (!s.backend.empty()) out << "# backend: " << s.backend << "\n";
+    for (const auto& o : s.overrides) out << "# set " << o << "\n";
+    out << "# tables: device trajectory, forces, tools, stamps (README: Interactive mode and haptics)\n";
+    haptics::write_trajectory_table(out, s.trajectory);
+    if (!s.forces.empty()) {
+      out << join(kForceHeader) << "\n";
+      for (const SessionForce& f : s.forces)
+        out << num(f.t_s) << "," << num(f.force_n.x()) << "," << num(f.force_n.y()) << "," << num(f.force_n.z()) << ","
+            << num(f.penetration_m) << "\n";
+    }
+    out << join(kToolHeader) << "\n";
+    for (std::size_t i = 0; i < s.tools.size(); ++i) out << i << "," << tool_fields(s.tools[i]) << "\n";
+    out << join(kStampHeader) << "\n";
+    for (std::size_t i = 0; i < s.stamps.size(); ++i) {
+      const SessionStamp& st = s.stamps[i];
+      out << i << "," << num(st.t_s) << "," << num(st.pose.xy.x()) << "," << num(st.pose.xy.y()) << ","
+          << num(st.pose.bottom_z) << "," << num(st.pose.heading_rad) << "," << num(st.motion_dir.x()) << ","
+          << num(st.motion_dir.y()) << "," << st.tool << "\n";
+    }
+    out.flush();
+    if (!out) throw std::runtime_error("writing " + tmp.string() + " failed");
+  });
+}
+
+Session read_session(const std::filesystem::path& file, const std::string& option) {
+  CsvFile f;
+  try {
+    f = haptics::read_csv_tables(file.string());
+  } catch (const InputError& e) {
+    throw InputError(option + " " + e.what());
+  }
+  try {
+    Session s;
+    for (const std::string& c : f.comments) {
+      if (c.rfind("set ", 0) == 0) {
+        const std::string o = c.substr(4);
+        if (o.find('=') == std::string::npos)
+          throw InputError(f.name + ": comment '# " + c + "' must be '# set key=value'");
+        s.overrides.push_back(o);
+      } else if (c.rfind("scene: ", 0) == 0) {
+        s.scene = c.substr(7);
+      } else if (c.rfind("backend: ", 0) == 0) {
+        s.backend = c.substr(9);
+      }
+    }
+    if (f.find(haptics::kTrajectoryHeader)) s.trajectory = haptics::trajectory_from(f);
+    if (const CsvTable* t = f.find(kForceHeader)) {
+      for (std::size_t r = 0; r < t->rows.size(); ++r)
+        s.forces.push_back({csv_number(f, *t, r, 0),
+                            {csv_number(f, *t, r, 1), csv_number(f, *t, r, 2), csv_number(f, *t, r, 3)},
+                            csv_number(f, *t, r, 4)});
+    }
+    const CsvTable* tools = f.find(kToolHeader);
+    const CsvTable* stamps = f.find(kStampHeader);
+    if (!tools || !stamps)
+      throw InputError(f.name + ": not a session file: it needs the tables '" + join(kToolHeader) + "' and '" +
+                       join(kStampHeader) + "' (sandbench interactive --record writes them)");
+    for (std::size_t r = 0; r < tools->rows.size(); ++r) {
+      if (csv_index(f, *tools, r, 0) != r) csv_fail(f, tools->lines[r], "column tool must count 0, 1, 2, ...");
+      s.tools.push_back(read_tool(f, *tools, r));
+    }
+    for (std::size_t r = 0; r < stamps->rows.size(); ++r) {
+      SessionStamp st;
+      st.t_s = csv_number(f, *stamps, r, 1);
+      st.pose.xy = {csv_number(f, *stamps, r, 2), csv_number(f, *stamps, r, 3)};
+      st.pose.bottom_z = csv_number(f, *stamps, r, 4);
+      st.pose.heading_rad = csv_number(f, *stamps, r, 5);
+      st.motion_dir = {csv_number(f, *stamps, r, 6), csv_number(f, *stamps, r, 7)};
+      st.tool = csv_index(f, *stamps, r, 8);
+      if (st.tool >= s.tools.size())
+        csv_fail(f, stamps->lines[r], "column tool = " + stamps->rows[r][8] + " names no row of the tool table");
+      s.stamps.push_back(st);
+    }
+    return s;
+  } catch (const InputError& e) {
+    throw InputError(option + " " + e.what());
+  }
+}
+
+StampSchedule session_schedule(const Session& session) {
+  StampSchedule schedule;
+  std::uint32_t generation = 0;
+  for (const SessionStamp& st : session.stamps) {
+    if (!schedule.stamps.empty()) schedule.length_m += (st.pose.xy - schedule.stamps.back().pose.xy).norm();
+    schedule.stamps.push_back(make_stamp(session.tools[st.tool], st.pose, st.motion_dir, generation++));
+  }
+  return schedule;
+}
+
+}  // namespace sb

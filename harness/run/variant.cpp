@@ -1,0 +1,72 @@
+#include "harness/run/variant.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+
+#include "common/input_error.hpp"
+#include "harness/run/backends.hpp"
+
+namespace sb {
+
+ProgressFn terminal_progress(const std::string& label) {
+  if (!::isatty(STDERR_FILENO)) return {};
+  return [label](std::size_t done, std::size_t total) {
+    std::fprintf(stderr, "\r[%s] stamp %zu/%zu", label.c_str(), done, total);
+    if (done == total) std::fprintf(stderr, "\n");
+    std::fflush(stderr);
+  };
+}
+
+Variant parse_variant(const std::string& text) {
+  Variant v;
+  v.label = text;
+  std::size_t start = 0;
+  const std::size_t colon = text.find(':');
+  v.backend = text.substr(0, colon);
+  const auto names = backend_names();
+  if (std::find(names.begin(), names.end(), v.backend) == names.end())
+    throw InputError("--backends: \"" + v.backend +
+                     "\" is not a back-end; must be tin or grid, optionally "
+                     "followed by :key=value overrides (e.g. grid:grid.storage=float)");
+  if (colon == std::string::npos) return v;
+  start = colon + 1;
+  while (start <= text.size()) {
+    const std::size_t next = text.find(':', start);
+    const std::string part = text.substr(start, next == std::string::npos ? std::string::npos : next - start);
+    if (part.find('=') == std::string::npos)
+      throw InputError("--backends: \"" + part + "\" in \"" + text + "\" must be key=value");
+    v.overrides.push_back(part);
+    if (next == std::string::npos) break;
+    start = next + 1;
+  }
+  return v;
+}
+
+VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_progress) {
+  std::vector<std::string> overrides = base.scene.overrides;
+  overrides.insert(overrides.end(), v.overrides.begin(), v.overrides.end());
+  Scene scene = base.scene;
+  if (!v.overrides.empty()) {
+    scene =
+        parse_scene(base.scene.text, base.scene.path, overrides, std::filesystem::path(base.scene.path).parent_path());
+  }
+  PreparedScene prepared = base;
+  prepared.scene = scene;
+  prepared.rule = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg);
+
+  auto terrain = make_terrain(v.backend, prepared.scene, prepared.initial);
+  VariantRun out{
+      run_schedule(*terrain, prepared, show_progress ? terminal_progress(v.label) : ProgressFn{}), prepared, {}};
+  out.run.label = v.label;
+  out.summary = summarize(out.run, prepared);
+  return out;
+}
+
+std::filesystem::path default_run_path(const std::string& scene_path, const std::string& label) {
+  std::string safe;
+  for (char c : label) safe += (std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_') ? c : '-';
+  return std::filesystem::path(std::filesystem::path(scene_path).stem().string() + "-" + safe + ".h5");
+}
+
+}  // namespace sb

@@ -1,0 +1,30 @@
+#pragma once
+// Options of `sandbench interactive` (harness/cli/interactive.cpp parses them).
+#include <string>
+#include <vector>
+
+namespace sb {
+
+struct InteractiveOptions {
+  std::string scene;
+  std::string backend;                 // tin | grid, optionally grid:key=value:...
+  std::string device = "mouse";        // mouse | replay:FILE | udp:PORT
+  std::vector<std::string> overrides;  // --set
+  std::string record;                  // session file; recording starts at once
+  std::string screenshot;              // PNG of the last frame
+  std::string stats;                   // haptic statistics JSON
+  long frames = 0;                     // 0: until the window is closed
+  double max_force_n = 8.0;
+  double max_stiffness_n_per_m = 2000.0;
+  double rate_hz = 1000.0;
+  double spin_us = 150.0;
+  bool realtime = true;
+  int width = 1280, height = 800;
+};
+
+// Opens the window and runs until it is closed or `frames` frames were drawn. Throws
+// InputError for bad options (before any window opens), std::runtime_error when no window
+// can be opened.
+void run_interactive(const InteractiveOptions& options);
+
+}  // namespace sb
