@@ -11,6 +11,7 @@ packages=(
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   python3-numpy python3-matplotlib python3-h5py
   libglfw3-dev libimgui-dev xvfb xauth
+  libopenvdb-dev libtbb-dev
 )
 
 # `deps.sh fuzz` adds clang and its libFuzzer runtime (for `make fuzz` only).

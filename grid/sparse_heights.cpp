@@ -35,8 +35,8 @@ struct SparseHeights<Real>::Tree {
   // The voxel of node (ix, iy).
   static openvdb::Coord voxel(std::size_t ix, std::size_t iy) {
     const std::size_t a = ix & 7, b = iy & 7;
-    return origin(ix >> 3, iy >> 3) + openvdb::Coord(static_cast<openvdb::Int32>((a >> 2) + 2 * (b >> 2)),
-                                                     static_cast<openvdb::Int32>(b & 3),
+    return origin(ix >> 3, iy >> 3) + openvdb::Coord(static_cast<openvdb::Int32>(b >> 1),
+                                                     static_cast<openvdb::Int32>(2 * (b & 1) + (a >> 2)),
                                                      static_cast<openvdb::Int32>(a & 3));
   }
 

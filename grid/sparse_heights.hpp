@@ -8,8 +8,10 @@
 // one block is one LeafNode<Real, 2> (4 x 4 x 4 = 64 voxels, every voxel a node: a leaf
 // wastes voxels only where a block overhangs the grid's last row or column). Node (x, y)
 // of block (X, Y) = (x / 8, y / 8), with (a, b) = (x % 8, y % 8), is the voxel
-//   leaf origin (4 X, 4 (Y / 4), 4 (Y % 4))  +  ((a / 4) + 2 (b / 4), b % 4, a % 4),
-// so a block's 8 x 8 nodes fill its leaf and the leaves of 4 consecutive block rows fill the
+//   leaf origin (4 X, 4 (Y / 4), 4 (Y % 4))  +  (b / 2, 2 (b % 2) + a / 4, a % 4),
+// whose offset in the leaf's buffer (16 i + 4 j + k for voxel (i, j, k)) is 8 b + a: the
+// block's nodes lie row by row in its buffer. A block's 8 x 8 nodes fill its leaf and the
+// leaves of 4 consecutive block rows fill the
 // z levels of their InternalNode<., 2> (4 x 4 x 4 leaves: 32 x 128 nodes per internal
 // node). The tree is Root -> Internal(log2 2) -> Leaf(log2 2); OpenVDB's default 5-4-3
 // configuration would spend 256 KiB on its top internal node before the first leaf.
@@ -129,9 +131,7 @@ class SparseHeights {
 
   // The voxel offset of node (ix, iy) inside its leaf (LeafNode::coordToOffset of the voxel
   // the mapping above assigns to it).
-  static std::size_t voxel_offset(std::size_t ix, std::size_t iy) {
-    return (((ix >> 2) & 1) | (((iy >> 2) & 1) << 1)) << 4 | (iy & 3) << 2 | (ix & 3);
-  }
+  static std::size_t voxel_offset(std::size_t ix, std::size_t iy) { return (iy & 7) << 3 | (ix & 7); }
 
  private:
   // Block state bits.

@@ -12,7 +12,7 @@ void add_interactive_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "interactive", "Touch the sand: a window, a tool driven by a haptic device (or the mouse), forces at 1 kHz");
   cmd->add_option("scene", o->scene, "Scene file (TOML)")->required();
-  cmd->add_option("--backend", o->backend, "tin | grid (optionally grid:key=value:...)")->required();
+  cmd->add_option("--backend", o->backend, "tin | grid | sparse (optionally grid:key=value:...)")->required();
   cmd->add_option("--device", o->device, "mouse | replay:FILE (CSV t,x,y,z,buttons) | udp:PORT (loopback bridge)")
       ->capture_default_str();
   cmd->add_option("--record", o->record, "Record the session (trajectory, forces, tools, stamps) to this CSV file");

@@ -55,7 +55,7 @@ void add_run_command(CLI::App& app) {
   auto opts = std::make_shared<RunOptions>();
   CLI::App* cmd = app.add_subcommand("run", "Run one back-end on a scene's stroke and write an HDF5 run file");
   cmd->add_option("scene", opts->scene, "Scene file (TOML)")->required();
-  cmd->add_option("--backend", opts->backend, "tin | grid (optionally grid:key=value:...)")->required();
+  cmd->add_option("--backend", opts->backend, "tin | grid | sparse (optionally grid:key=value:...)")->required();
   cmd->add_option("--out", opts->out, "Run file to write (default: <scene>-<backend>.h5)");
   cmd->add_flag("--json", opts->json, "Print the summary as JSON on stdout");
   cmd->add_option("--set", opts->overrides, "Override a scene key: --set tool.radius_m=0.03")->take_all();

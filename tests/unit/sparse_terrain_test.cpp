@@ -14,8 +14,8 @@
 #include "common/scene.hpp"
 #include "counting_allocator.hpp"
 #include "grid/grid_terrain.hpp"
-#include "harness/backends.hpp"
-#include "harness/runner.hpp"
+#include "harness/run/backends.hpp"
+#include "harness/run/runner.hpp"
 
 namespace sb::grid {
 namespace {
