@@ -19,6 +19,7 @@ import exp_fig5_6
 import exp_fig7
 import exp_fig8_9
 import exp_memory
+import exp_sparse
 import exp_stability
 
 EXPERIMENTS = {
@@ -26,6 +27,7 @@ EXPERIMENTS = {
     "fig7": exp_fig7,
     "fig8_9": exp_fig8_9,
     "memory": exp_memory,
+    "sparse": exp_sparse,
     "drift": exp_drift,
     "alpha_flat": exp_alpha_flat,
     "accuracy": exp_accuracy,
@@ -51,7 +53,7 @@ def machine_header(ctx):
     compiler = subprocess.run(["c++", "--version"], capture_output=True, text=True).stdout.splitlines()[0]
     libs = ", ".join(f"{n} {package_version(p)}" for n, p in
                      [("CGAL", "libcgal-dev"), ("Eigen", "libeigen3-dev"), ("HDF5", "libhdf5-dev"),
-                      ("OSMesa", "libosmesa6-dev")])
+                      ("OSMesa", "libosmesa6-dev"), ("OpenVDB", "libopenvdb-dev")])
     return (f"- date: {datetime.date.today().isoformat()}; profile: {ctx.profile_name}\n"
             f"- {version}, built with {compiler}\n"
             f"- machine: {platform.machine()}, {cpu}, {len(os.sched_getaffinity(0))} cores; {platform.platform()}\n"
