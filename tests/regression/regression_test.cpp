@@ -35,9 +35,11 @@ const std::vector<Case>& cases() {
       {"flat_stroke-tin", "flat_stroke.toml", "tin", {}},
       {"flat_stroke-grid", "flat_stroke.toml", "grid", {}},
       {"flat_stroke-grid-float", "flat_stroke.toml", "grid", {"grid.storage=float"}},
+      {"flat_stroke-sparse", "flat_stroke.toml", "sparse", {}},
       {"pile-tin", "pile.toml", "tin", {}},
       {"pile-grid", "pile.toml", "grid", {}},
       {"pile-grid-4", "pile.toml", "grid", {"grid.neighbours=4"}},
+      {"pile-sparse", "pile.toml", "sparse", {}},
       {"dunes-tin", "dunes.toml", "tin", {}},
       {"dunes-grid", "dunes.toml", "grid", {}},
   };
@@ -110,8 +112,9 @@ TEST_P(Regression, MetricsWithinGoldenBounds) {
   ASSERT_TRUE(in) << "no golden " << golden_path(c) << "; run `make goldens`";
   const auto golden = nlohmann::json::parse(in);
   // Whatever the golden says, a pile must stand at the critical angle (issue: within 2 degrees).
-  if (summary.contains("pile.flank_angle_deg"))
+  if (summary.contains("pile.flank_angle_deg")) {
     EXPECT_NEAR(summary["pile.flank_angle_deg"].get<double>(), 30.0, 2.0) << c.name;
+  }
   for (const auto& [metric, bound] : golden.at("metrics").items()) {
     ASSERT_TRUE(summary.contains(metric)) << metric;
     const double v = summary[metric].get<double>();
