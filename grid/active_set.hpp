@@ -41,7 +41,10 @@ class DenseIdleCounts {
     count = 0;
     return true;
   }
-  void reset(std::size_t ix, std::size_t iy) { counts_[iy * nx_ + ix] = 0; }
+  // Counts of nodes x0..x1 of row y back to 0.
+  void reset(std::size_t y, std::size_t x0, std::size_t x1) {
+    for (std::size_t x = x0; x <= x1; ++x) counts_[y * nx_ + x] = 0;
+  }
   std::size_t bytes() const { return counts_.capacity() * sizeof(std::uint16_t); }
   // Counts below idle_passes, zero for non-members.
   void check(const std::vector<std::uint64_t>& bits, std::size_t words_per_row, std::uint16_t idle_passes,
@@ -64,13 +67,13 @@ class BasicActiveSet {
     const std::size_t x0 = ix > 0 ? ix - 1 : 0, x1 = ix + 1 < nx_ ? ix + 1 : ix;
     for (std::size_t y = y0; y <= y1; ++y) {
       set_bits(y, x0, x1);
-      for (std::size_t x = x0; x <= x1; ++x) idle_.reset(x, y);
+      idle_.reset(y, x0, x1);
     }
   }
   // Node (ix, iy) alone becomes a member with a fresh idle count.
   void activate(std::size_t ix, std::size_t iy) {
     set_bits(iy, ix, ix);
-    idle_.reset(ix, iy);
+    idle_.reset(iy, ix, ix);
   }
   // Node (ix, iy) was visited and stayed put: it leaves after idle_passes such visits in a row.
   void idle(std::size_t ix, std::size_t iy) {

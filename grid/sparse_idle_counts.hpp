@@ -5,7 +5,9 @@
 // counts, bit p of node b's count in bit b of plane p. The default idle_passes = 2 needs one
 // bit per node (the dense policy: 16); idle_passes = 1 none.
 //
-// Memory: P / 8 bytes per node (rows padded to 64 nodes). count_up / reset O(P).
+// Memory: P / 8 bytes per node (rows padded to 64 nodes). count_up O(P); reset O(P) per
+// bitmap word it touches (a run of nodes is cleared with one mask per word and plane).
+#include <algorithm>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -34,9 +36,16 @@ class BitPlaneIdleCounts {
       w[p] = (w[p] & ~(std::uint64_t{1} << b)) | (static_cast<std::uint64_t>((count >> p) & 1u) << b);
     return count == 0;
   }
-  void reset(std::size_t ix, std::size_t iy) {
-    std::uint64_t* w = bits_.data() + (iy * words_per_row_ + ix / 64) * planes_;
-    for (unsigned p = 0; p < planes_; ++p) w[p] &= ~(std::uint64_t{1} << (ix % 64));
+  // Counts of nodes x0..x1 of row y back to 0.
+  void reset(std::size_t y, std::size_t x0, std::size_t x1) {
+    for (std::size_t x = x0; x <= x1;) {
+      const std::size_t lo = x % 64, hi = std::min<std::size_t>(63, lo + (x1 - x));
+      const std::uint64_t keep =
+          ~((hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & ~((std::uint64_t{1} << lo) - 1));
+      std::uint64_t* w = bits_.data() + (y * words_per_row_ + x / 64) * planes_;
+      for (unsigned p = 0; p < planes_; ++p) w[p] &= keep;
+      x += hi - lo + 1;
+    }
   }
   std::size_t bytes() const { return bits_.capacity() * sizeof(std::uint64_t); }
   // Counts below idle_passes, zero for non-members. O(nodes * P).

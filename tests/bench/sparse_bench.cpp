@@ -3,7 +3,7 @@
 // two back-ends compute the same heights (tests/unit/sparse_terrain_test.cpp), so the
 // ratios are the price of the sparse storage alone.
 //
-//   build/<dir>/tests/sparse_bench --benchmark_repetitions=7 \
+//   build/<dir>/tests/sparse_bench --benchmark_repetitions=7
 //       --benchmark_enable_random_interleaving=true --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
@@ -53,7 +53,7 @@ void BM_Scene(benchmark::State& state, const std::string& backend, const std::st
 }
 
 const int kRegistered = [] {
-  for (const char* name : {"flat_stroke", "pile", "trench", "dunes"})
+  for (const char* name : {"flat_stroke", "pile", "trench", "dunes", "heightmap"})
     for (const char* backend : {"grid", "sparse"})
       benchmark::RegisterBenchmark((std::string("BM_Scene/") + name + "/" + backend).c_str(), BM_Scene, backend, name)
           ->Unit(benchmark::kMillisecond);
