@@ -361,6 +361,19 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   const double samples = (s.domain.size_m.x() / s.output.raster_m + 1) * (s.domain.size_m.y() / s.output.raster_m + 1);
   if (samples > 1e8) Fields::fail("output.raster_m", "gives more than 1e8 raster samples for this domain");
   s.output.energy = f.boolean("output.energy", false);
+
+  // [haptics] (common/haptics/rendering.hpp; only `sandbench interactive` uses them)
+  haptics::RenderingOptions& h = s.haptics;
+  h.blend_s = 1e-3 * f.number("haptics.blend_ms", 1e3 * h.blend_s, closed(0.0, 1000.0));
+  h.max_force_rate_n_per_s = f.number("haptics.max_force_rate_n_per_s", h.max_force_rate_n_per_s, closed(0.0, 1e6));
+  h.passivity = f.boolean("haptics.passivity_control", h.passivity);
+  h.passivity_max_force_n = f.number("haptics.passivity_max_force_n", h.passivity_max_force_n, closed(0.0, 1e3));
+  h.coupling = f.boolean("haptics.coupling", h.coupling);
+  h.coupling_stiffness_n_per_m =
+      f.number("haptics.coupling_stiffness_n_per_m", h.coupling_stiffness_n_per_m, positive(1e6));
+  h.coupling_damping_n_s_per_m =
+      f.number("haptics.coupling_damping_n_s_per_m", h.coupling_damping_n_s_per_m, closed(0.0, 1e4));
+  h.tool_mass_kg = f.number("haptics.tool_mass_kg", h.tool_mass_kg, positive(100.0));
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "common/geometry.hpp"
+#include "common/haptics/rendering.hpp"
 #include "common/material.hpp"
 #include "common/schedule.hpp"
 #include "common/tool.hpp"
@@ -91,6 +92,7 @@ struct Scene {
   TinSpec tin;
   GridSpec grid;
   OutputSpec output;
+  haptics::RenderingOptions haptics;  // [haptics]: how the interactive servo renders forces
   ReferenceKind reference = ReferenceKind::None;
 };
 

@@ -18,6 +18,7 @@ import exp_drift
 import exp_fig5_6
 import exp_fig7
 import exp_fig8_9
+import exp_haptics
 import exp_memory
 import exp_sparse
 import exp_stability
@@ -32,6 +33,7 @@ EXPERIMENTS = {
     "alpha_flat": exp_alpha_flat,
     "accuracy": exp_accuracy,
     "stability": exp_stability,
+    "haptics": exp_haptics,
 }
 
 

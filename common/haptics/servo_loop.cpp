@@ -11,7 +11,9 @@ using std::chrono::duration;
 using std::chrono::nanoseconds;
 
 ServoLoop::ServoLoop(HapticDevice& device, PatchBuffer& patches, const ServoOptions& options)
-    : core_(device, patches, options.velocity_cutoff_hz), options_(options), samples_(options.record_capacity) {}
+    : core_(device, patches, options.velocity_cutoff_hz, options.rendering, 1.0 / options.rate_hz),
+      options_(options),
+      samples_(options.record_capacity) {}
 
 ServoLoop::~ServoLoop() { stop(); }
 
@@ -36,11 +38,15 @@ ServoStats ServoLoop::stats() const {
   s.late_us_p99 = late_us_.percentile(0.99);
   s.late_us_max = late_us_.max();
   s.force_limit_n = core_.limits().max_force_n;
+  s.force_step_n_p99 = force_step_n_.percentile(0.99);
+  s.force_step_n_p999 = force_step_n_.percentile(0.999);
+  s.force_step_n_max = force_step_n_.max();
   return s;
 }
 
 void ServoLoop::run() {
   stats_ = ServoStats{};
+  force_step_n_ = TickHistogram(0.001, 20.0);
   stats_.realtime = options_.realtime && request_realtime();
   const auto period = std::chrono::duration_cast<nanoseconds>(duration<double>(1.0 / options_.rate_hz));
   const auto spin = std::chrono::duration_cast<nanoseconds>(duration<double, std::micro>(options_.spin_us));
@@ -79,6 +85,9 @@ void ServoLoop::run() {
     stats_.ticks_in_contact += s.model.in_contact;
     stats_.ticks_without_pose += !s.device.valid;
     stats_.ticks_outside_patch += s.model.outside_patch;
+    force_step_n_.add(s.force_step_n);
+    stats_.patch_switches += s.patch_switched;
+    stats_.ticks_rate_limited += s.rate_limited;
     late_us_.add(duration<double, std::micro>(start - deadline).count());
     if (++rate_window_ticks, start - rate_window_start >= std::chrono::seconds(1)) {
       servo_hz = static_cast<double>(rate_window_ticks - 1) / duration<double>(start - rate_window_start).count();
@@ -109,6 +118,11 @@ void ServoLoop::run() {
     }
   }
   stats_.duration_s = duration<double>(last_start - first_start).count();
+  const PassivityController& pc = core_.passivity();
+  stats_.passivity_energy_j = pc.energy_j();
+  stats_.passivity_energy_max_j = pc.energy_max_j();
+  stats_.passivity_dissipated_j = pc.dissipated_j();
+  stats_.passivity_ticks_active = pc.active_ticks();
   stats_.servo_hz =
       stats_.ticks > 1 && stats_.duration_s > 0.0 ? static_cast<double>(stats_.ticks - 1) / stats_.duration_s : 0.0;
 }

@@ -23,6 +23,7 @@ struct ServoOptions {
   bool realtime = true;    // ask for SCHED_FIFO (silently not, when refused)
   double velocity_cutoff_hz = 40.0;
   std::size_t record_capacity = 1u << 17;  // samples queued for the recorder (131 s at 1 kHz)
+  RenderingOptions rendering;              // blend, rate limit, passivity, coupling
 };
 
 // One tick as recorded: the device trajectory plus the force sent.
@@ -50,6 +51,13 @@ struct ServoStats {
   std::uint64_t ticks_in_contact = 0, ticks_without_pose = 0, ticks_outside_patch = 0;
   std::uint64_t samples_dropped = 0;  // recording queue full
   bool realtime = false;              // SCHED_FIFO granted
+  // Continuity: |force(n) - force(n-1)| over all ticks (1 mN bins), and what shaped it.
+  double force_step_n_p99 = 0.0, force_step_n_p999 = 0.0, force_step_n_max = 0.0;
+  std::uint64_t patch_switches = 0, ticks_rate_limited = 0;
+  // Passivity (passivity.hpp): the observer's energy at the end and at most (J, > 0: energy
+  // was created), the damping the controller added.
+  double passivity_energy_j = 0.0, passivity_energy_max_j = 0.0, passivity_dissipated_j = 0.0;
+  std::uint64_t passivity_ticks_active = 0;
 };
 
 class ServoLoop {
@@ -86,6 +94,7 @@ class ServoLoop {
   SpscRing<ServoSample> samples_;
   // Servo thread only until joined.
   TickHistogram tick_us_, late_us_;
+  TickHistogram force_step_n_{0.001, 20.0};
   ServoStats stats_;
 };
 

@@ -12,7 +12,7 @@ double TickHistogram::percentile(double q) const {
   std::uint64_t seen = 0;
   for (std::size_t b = 0; b < bins_.size(); ++b) {
     seen += bins_[b];
-    if (seen >= std::max<std::uint64_t>(rank, 1)) return std::min(max_, (static_cast<double>(b) + 1.0) * kBinUs);
+    if (seen >= std::max<std::uint64_t>(rank, 1)) return std::min(max_, (static_cast<double>(b) + 1.0) * bin_);
   }
   return max_;
 }

@@ -29,6 +29,8 @@ class TripleBuffer {
     return true;
   }
   const T& front() const { return slots_[front_]; }
+  // Reader side: whether update() would take a new value now (one relaxed load).
+  bool pending() const { return (middle_.load(std::memory_order_relaxed) & kFresh) != 0; }
 
   // Before any thread starts: sets every slot (e.g. to reserve capacity).
   template <class F>

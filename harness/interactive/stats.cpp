@@ -33,6 +33,16 @@ Json haptic_stats_json(const haptics::ServoStats& s, const haptics::DeviceLimits
   j["ticks_outside_patch"] = s.ticks_outside_patch;
   j["samples_dropped"] = s.samples_dropped;
   j["realtime"] = s.realtime;
+  // Rendering (common/haptics/rendering.hpp): per-tick force change and passivity.
+  j["force_step_n.p99"] = s.force_step_n_p99;
+  j["force_step_n.p999"] = s.force_step_n_p999;
+  j["force_step_n.max"] = s.force_step_n_max;
+  j["patch_switches"] = s.patch_switches;
+  j["ticks_rate_limited"] = s.ticks_rate_limited;
+  j["passivity.energy_j"] = s.passivity_energy_j;
+  j["passivity.energy_max_j"] = s.passivity_energy_max_j;
+  j["passivity.dissipated_j"] = s.passivity_dissipated_j;
+  j["passivity.ticks_active"] = s.passivity_ticks_active;
   j["sim.steps"] = sim.steps;
   j["sim.stamps"] = sim.stamps;
   j["sim.step_ms.p50"] = percentile(sim.step_ms, 0.5);

@@ -190,6 +190,7 @@ void run_interactive(const InteractiveOptions& o) {
   servo_options.rate_hz = o.rate_hz;
   servo_options.spin_us = o.spin_us;
   servo_options.realtime = o.realtime;
+  servo_options.rendering = prepared.scene.haptics;
   haptics::ServoLoop servo(*device, patches, servo_options);
   Simulation sim(prepared, std::move(terrain), patches, servo, variant.label);
   auto* mouse_device = dynamic_cast<haptics::SharedPoseDevice*>(device.get());

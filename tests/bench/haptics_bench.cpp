@@ -75,34 +75,43 @@ void counters(benchmark::State& state, int backend) {
   state.SetLabel(name(backend));
 }
 
-// One servo tick: the tool 5 mm into the sand, moving, on a patch published from the model.
-void BM_ForceTick(benchmark::State& state) {
+// Servo ticks with the tool 5 mm into the sand, moving, on a patch published from the model;
+// with new_patch_every_tick, a new patch arrives before every tick (the rendering's worst
+// tick: the model runs on the old and on the new patch for the blend).
+void force_ticks(benchmark::State& state, const RenderingOptions& rendering, bool new_patch_every_tick) {
   const int backend = static_cast<int>(state.range(0));
   Terrain& t = terrain(backend);
   const ForceParams params = ForceParams::from(scene().material, scene().tool);
   const PatchLayout layout = PatchLayout::for_tool(params.reach_m, 0.015);
-  PatchBuffer patches;
-  reserve_patches(patches, layout.cells);
   const Vec2 centre(0.35, 0.35);
-  fill_patch(t, centre, layout, params, 1, patches.back());
+  HeightPatch filled;
+  fill_patch(t, centre, layout, params, 1, filled);
+  PatchBuffer patches;
+  patches.for_each_slot([&](HeightPatch& p) { p = filled; });  // every slot holds a valid patch
   patches.publish();
   DeviceLimits limits;
   limits.workspace.lo = Vec3(-1, -1, -1);
   limits.workspace.hi = Vec3(2, 2, 2);
   SharedPoseDevice device("bench", limits);
-  ServoCore core(device, patches);
+  ServoCore core(device, patches, 40.0, rendering);
   core.start();
   const double z = t.height(centre) - 0.005;
   double now = 0.0;
   for (auto _ : state) {
     now += 0.001;
     device.set_pose(Vec3(centre.x() + 0.005 * std::sin(now), centre.y(), z), 0);
+    if (new_patch_every_tick) patches.publish();
     const ServoState s = core.step(now);
     benchmark::DoNotOptimize(s.force_n);
   }
   counters(state, backend);
 }
+
+void BM_ForceTick(benchmark::State& state) { force_ticks(state, scene().haptics, false); }
 BENCHMARK(BM_ForceTick)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+void BM_ForceTickNewPatchEveryTick(benchmark::State& state) { force_ticks(state, scene().haptics, true); }
+BENCHMARK(BM_ForceTickNewPatchEveryTick)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 // The force model alone (no device, no hand-over).
 void BM_ForceModel(benchmark::State& state) {

@@ -17,25 +17,17 @@ namespace {
 const Vec2 kCentre(0.3, 0.3);
 
 DeviceLimits limits(double max_force_n = 4.0, double max_stiffness = 2000.0) {
-  DeviceLimits l;
-  l.max_force_n = max_force_n;
-  l.max_stiffness_n_per_m = max_stiffness;
-  l.workspace.lo = Vec3(0.0, 0.0, 0.0);
-  l.workspace.hi = Vec3(1.0, 1.0, 0.3);
-  return l;
+  return test::limits(max_force_n, max_stiffness);
 }
 
-void publish(PatchBuffer& b, const HeightPatch& p) {
-  b.back() = p;
-  b.publish();
-}
+using test::publish;
 
 TEST(HapticsServoCore, CommandsTheModelsForceWithinTheDeviceLimit) {
   SharedPoseDevice device("test", limits(4.0));
   PatchBuffer patches;
   const ForceParams params = ForceParams::from(test::sand(800.0), test::disk(0.02));
   publish(patches, test::flat_patch(0.1, kCentre, params));
-  ServoCore core(device, patches);
+  ServoCore core(device, patches, 40.0, test::raw_rendering());
   core.start();
 
   ServoState s = core.step(0.0);  // no pose yet: nothing
@@ -76,7 +68,8 @@ TEST(HapticsServoCore, EstimatesVelocityFromPositions) {
 
 // The loop with a replay device pressing into the sand and a second thread publishing
 // patches all the while, as the simulation does. Every force must be finite and within the
-// limit; the statistics must be coherent.
+// limit; the statistics must be coherent. The test waits for events (the replay played
+// through, states read), with a generous deadline, never for a fixed time.
 TEST(HapticsServoLoop, RunsBesideAPublisherAndKeepsForcesWithinLimits) {
   Trajectory t;
   for (int i = 0; i <= 100; ++i) {
@@ -105,14 +98,18 @@ TEST(HapticsServoLoop, RunsBesideAPublisherAndKeepsForcesWithinLimits) {
     }
   });
   loop.start();
-  // Read what the servo publishes for the simulation, as it would.
-  std::uint64_t states = 0;
+  // Read what the servo publishes for the simulation, as it would, until the replay has
+  // played through and held its last pose for 100 more ticks.
+  std::uint64_t states = 0, last_tick = 0, finished_at = 0;
   bool finite = true;
-  const auto until = std::chrono::steady_clock::now() + std::chrono::milliseconds(600);
-  while (std::chrono::steady_clock::now() < until) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
     if (loop.to_simulation().update()) {
       ++states;
       finite &= loop.to_simulation().front().force_n.allFinite();
+      last_tick = loop.to_simulation().front().tick;
+      if (device.finished() && finished_at == 0) finished_at = last_tick;
+      if (finished_at > 0 && last_tick > finished_at + 100) break;
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
@@ -121,7 +118,8 @@ TEST(HapticsServoLoop, RunsBesideAPublisherAndKeepsForcesWithinLimits) {
   simulation.join();
 
   const ServoStats s = loop.stats();
-  EXPECT_GT(s.ticks, 10u);
+  ASSERT_GT(finished_at, 0u) << "the replay did not play through within 60 s";
+  EXPECT_GT(s.ticks, finished_at + 100);
   EXPECT_GT(states, 0u);
   EXPECT_TRUE(finite);
   EXPECT_EQ(s.forces_nonfinite, 0u);
@@ -158,7 +156,14 @@ TEST(HapticsServoLoop, StopIsIdempotentAndStartsAgain) {
   loop.stop();
   loop.start();
   EXPECT_TRUE(loop.running());
-  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  // Until the first tick is published (a generous deadline, not a fixed time).
+  bool ticked = false;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (!ticked && std::chrono::steady_clock::now() < deadline) {
+    ticked = loop.to_display().update();
+    if (!ticked) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_TRUE(ticked);
   loop.stop();
   loop.stop();
   EXPECT_FALSE(loop.running());

@@ -2,7 +2,9 @@
 // Patches and tools shared by the haptics unit tests.
 #include <functional>
 
+#include "common/haptics/device.hpp"
 #include "common/haptics/height_patch.hpp"
+#include "common/haptics/rendering.hpp"
 
 namespace sb::haptics::test {
 
@@ -14,6 +16,31 @@ inline ToolSpec disk(double radius_m, BottomProfile profile = BottomProfile::Fla
   t.profile = profile;
   t.sphere_radius_m = radius_m;
   return t;
+}
+
+// A device's limits with a workspace of [0, 1] x [0, 1] x [0, 0.3] m.
+inline DeviceLimits limits(double max_force_n = 8.0, double max_stiffness = 2000.0) {
+  DeviceLimits l;
+  l.max_force_n = max_force_n;
+  l.max_stiffness_n_per_m = max_stiffness;
+  l.workspace.lo = Vec3(0.0, 0.0, 0.0);
+  l.workspace.hi = Vec3(1.0, 1.0, 0.3);
+  return l;
+}
+
+// Publishes `p` as the simulation does.
+inline void publish(PatchBuffer& b, const HeightPatch& p) {
+  b.back() = p;
+  b.publish();
+}
+
+// The force model's output sent as it is: no blend, no rate limit, no passivity control.
+inline RenderingOptions raw_rendering() {
+  RenderingOptions r;
+  r.blend_s = 0.0;
+  r.max_force_rate_n_per_s = 0.0;
+  r.passivity = false;
+  return r;
 }
 
 inline Material sand(double stiffness = 800.0, double drag = 5.0, double friction = 0.4) {
