@@ -10,7 +10,7 @@ FULL ?= 0
 
 FUZZ_SECONDS ?= 60
 
-.PHONY: all deps configure build test test-asan reproduce bench goldens fuzz clean
+.PHONY: all deps configure build test test-asan reproduce bench goldens fuzz format format-check lint clean
 
 all: build
 
@@ -57,6 +57,24 @@ fuzz:
 		mkdir -p build/fuzz/corpus-$$t; \
 		(cd build/fuzz && ./tests/fuzz/$$t -max_total_time=$(FUZZ_SECONDS) -print_final_stats=1 corpus-$$t) || exit 1; \
 	done
+
+# Formatting (.clang-format) and static checks (.clang-tidy) on the C++ sources git tracks.
+# format-check fails on any difference (CI runs it); `make format` rewrites the files.
+# lint adds clang-tidy over the compile database (slow: CGAL headers; run it locally).
+CXX_SOURCES = $(shell git ls-files '*.cpp' '*.hpp' '*.h')
+TIDY_SCOPE := '^$(CURDIR)/(common|grid|tin|harness)/'
+
+format-check:
+	@bash .ci/deps.sh
+	@clang-format --dry-run -Werror $(CXX_SOURCES) && echo "format-check: $(words $(CXX_SOURCES)) files formatted"
+
+format:
+	@bash .ci/deps.sh
+	@clang-format -i $(CXX_SOURCES)
+
+lint: format-check configure
+	@bash .ci/deps.sh lint
+	@run-clang-tidy -quiet -j$(JOBS) -p $(BUILD_DIR) $(TIDY_SCOPE)
 
 clean:
 	@rm -rf build

@@ -12,11 +12,16 @@ packages=(
   python3-numpy python3-matplotlib python3-h5py
   libglfw3-dev libimgui-dev xvfb xauth
   libopenvdb-dev libtbb-dev
+  libcairo2-dev fonts-dejavu-core libepoxy-dev
+  clang-format
 )
 
-# `deps.sh fuzz` adds clang and its libFuzzer runtime (for `make fuzz` only).
+# `deps.sh fuzz` adds clang and its libFuzzer runtime (for `make fuzz` only); `deps.sh lint`
+# clang-tidy (for `make lint`; clang-format is always installed: CI checks the formatting).
 if [[ "${1:-}" == "fuzz" ]]; then
   packages+=(clang libclang-rt-14-dev)
+elif [[ "${1:-}" == "lint" ]]; then
+  packages+=(clang-tidy)
 fi
 
 missing=()

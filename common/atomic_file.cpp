@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <fstream>
+#include <stdexcept>
 #include <string>
 
 namespace sb {
@@ -18,6 +20,15 @@ void write_atomically(const std::filesystem::path& target,
     std::filesystem::remove(temporary, ignored);
     throw;
   }
+}
+
+void write_text_atomically(const std::filesystem::path& target, std::string_view text) {
+  write_atomically(target, [&](const std::filesystem::path& temporary) {
+    std::ofstream out(temporary, std::ios::binary);
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    out.close();
+    if (!out) throw std::runtime_error("cannot write " + temporary.string());
+  });
 }
 
 }  // namespace sb

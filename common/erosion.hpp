@@ -1,5 +1,5 @@
 #pragma once
-// The one erosion rule of DESIGN.md, stated once for every back-end.
+// The one erosion rule (README "Architecture"), stated once for every back-end.
 //
 // Between a centre i and a neighbour j at horizontal distance d, material moves from the
 // higher to the lower when (z_i - z_j) / d > tan(critical angle). The pair's volume

@@ -5,6 +5,7 @@
 #include <numbers>
 #include <random>
 
+#include "common/bilinear.hpp"
 #include "common/png_io.hpp"
 
 namespace sb {
@@ -74,15 +75,9 @@ double HeightField::operator()(const Vec2& p) const {
     }
     case TerrainKind::Heightmap: {
       const Vec2 g = (p - domain_.origin_m).cwiseQuotient(domain_.size_m);
-      const double gx = std::clamp(g.x(), 0.0, 1.0) * static_cast<double>(img_w_ - 1);
-      const double gy = std::clamp(g.y(), 0.0, 1.0) * static_cast<double>(img_h_ - 1);
-      const std::size_t ix = std::min(static_cast<std::size_t>(gx), img_w_ > 1 ? img_w_ - 2 : 0);
-      const std::size_t iy = std::min(static_cast<std::size_t>(gy), img_h_ > 1 ? img_h_ - 2 : 0);
-      const std::size_t ix1 = std::min(ix + 1, img_w_ - 1), iy1 = std::min(iy + 1, img_h_ - 1);
-      const double tx = gx - ix, ty = gy - iy;
-      auto v = [&](std::size_t x, std::size_t y) { return img_[y * img_w_ + x]; };
-      return (1 - tx) * (1 - ty) * v(ix, iy) + tx * (1 - ty) * v(ix1, iy) + (1 - tx) * ty * v(ix, iy1) +
-             tx * ty * v(ix1, iy1);
+      return bilinear(std::clamp(g.x(), 0.0, 1.0) * static_cast<double>(img_w_ - 1),
+                      std::clamp(g.y(), 0.0, 1.0) * static_cast<double>(img_h_ - 1), img_w_, img_h_,
+                      [&](std::size_t x, std::size_t y) { return static_cast<double>(img_[y * img_w_ + x]); });
     }
   }
   return base_m_;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "common/bilinear.hpp"
+
 namespace sb {
 
 Raster Raster::covering(const Aabb2& box, double spacing_m) {
@@ -20,14 +22,7 @@ Raster Raster::covering(const Aabb2& box, double spacing_m) {
 
 double Raster::interpolate(const Vec2& p) const {
   const Vec2 g = (p - origin_m) / spacing_m;
-  const double gx = std::clamp(g.x(), 0.0, static_cast<double>(nx - 1));
-  const double gy = std::clamp(g.y(), 0.0, static_cast<double>(ny - 1));
-  const auto ix = std::min(static_cast<std::size_t>(gx), nx > 1 ? nx - 2 : 0);
-  const auto iy = std::min(static_cast<std::size_t>(gy), ny > 1 ? ny - 2 : 0);
-  const double tx = nx > 1 ? gx - ix : 0.0, ty = ny > 1 ? gy - iy : 0.0;
-  const std::size_t ix1 = std::min(ix + 1, nx - 1), iy1 = std::min(iy + 1, ny - 1);
-  return (1 - tx) * (1 - ty) * at(ix, iy) + tx * (1 - ty) * at(ix1, iy) + (1 - tx) * ty * at(ix, iy1) +
-         tx * ty * at(ix1, iy1);
+  return bilinear(g.x(), g.y(), nx, ny, [&](std::size_t ix, std::size_t iy) { return at(ix, iy); });
 }
 
 RasterDifference compare_rasters(const Raster& a, const Raster& b) {

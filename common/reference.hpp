@@ -38,7 +38,7 @@ struct TrenchShape {
 };
 TrenchShape measure_trench(const Raster& heights, const Raster& initial, const Vec2& a, const Vec2& b);
 
-// The accuracy metrics of DESIGN.md for the scene's reference, as summary entries
+// The accuracy metrics (README "Summary metrics") for the scene's reference, as summary entries
 // ("reference.rmse_m", "pile.flank_angle_deg", ...). Empty when the scene has none.
 nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule& schedule, const HeightField& initial,
                                         const Raster& initial_raster, const Raster& final_raster);

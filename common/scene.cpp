@@ -282,11 +282,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   // [tool]
   const std::string shape = f.choice("tool.shape", "disk", {"disk", "box", "ellipse", "polygon", "pour"});
   ToolSpec& t = s.tool;
-  t.shape = shape == "disk"      ? ToolShape::Disk
-            : shape == "box"     ? ToolShape::Box
-            : shape == "ellipse" ? ToolShape::Ellipse
-            : shape == "polygon" ? ToolShape::Polygon
-                                 : ToolShape::Pour;
+  t.shape = *tool_shape_from(shape);
   const Range tool_size = positive(extent * 10.0);
   if (t.shape == ToolShape::Disk || t.shape == ToolShape::Pour) t.radius_m = f.number("tool.radius_m", 0.02, tool_size);
   if (t.shape == ToolShape::Box || t.shape == ToolShape::Ellipse) {
@@ -305,7 +301,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   } else {
     t.depth_m = f.number("tool.depth_m", 0.01, open(-1e6, 1e6));
     const std::string profile = f.choice("tool.profile", "flat", {"flat", "sphere_cap"});
-    t.profile = profile == "flat" ? BottomProfile::Flat : BottomProfile::SphereCap;
+    t.profile = *bottom_profile_from(profile);
     if (t.profile == BottomProfile::SphereCap) t.sphere_radius_m = f.number("tool.sphere_radius_m", 0.05, tool_size);
     t.rim.width_m = f.number("tool.rim_width_m",
                              0.5 * (t.shape == ToolShape::Disk ? t.radius_m : t.half_size_m.minCoeff()), tool_size);

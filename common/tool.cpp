@@ -3,26 +3,67 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <sstream>
+#include <utility>
 
 namespace sb {
 
-std::string to_string(ToolShape s) {
-  switch (s) {
-    case ToolShape::Disk:
-      return "disk";
-    case ToolShape::Box:
-      return "box";
-    case ToolShape::Ellipse:
-      return "ellipse";
-    case ToolShape::Polygon:
-      return "polygon";
-    case ToolShape::Pour:
-      return "pour";
-  }
+namespace {
+constexpr std::pair<ToolShape, std::string_view> kShapeNames[] = {{ToolShape::Disk, "disk"},
+                                                                  {ToolShape::Box, "box"},
+                                                                  {ToolShape::Ellipse, "ellipse"},
+                                                                  {ToolShape::Polygon, "polygon"},
+                                                                  {ToolShape::Pour, "pour"}};
+constexpr std::pair<BottomProfile, std::string_view> kProfileNames[] = {{BottomProfile::Flat, "flat"},
+                                                                        {BottomProfile::SphereCap, "sphere_cap"}};
+
+template <typename Enum, std::size_t N>
+std::string name_of(const std::pair<Enum, std::string_view> (&table)[N], Enum e) {
+  for (const auto& [value, name] : table)
+    if (value == e) return std::string(name);
   return "?";
 }
 
-std::string to_string(BottomProfile p) { return p == BottomProfile::Flat ? "flat" : "sphere_cap"; }
+template <typename Enum, std::size_t N>
+std::optional<Enum> value_of(const std::pair<Enum, std::string_view> (&table)[N], std::string_view name) {
+  for (const auto& [value, n] : table)
+    if (n == name) return value;
+  return std::nullopt;
+}
+
+std::string number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
+}  // namespace
+
+std::string to_string(ToolShape s) { return name_of(kShapeNames, s); }
+std::string to_string(BottomProfile p) { return name_of(kProfileNames, p); }
+std::optional<ToolShape> tool_shape_from(std::string_view name) { return value_of(kShapeNames, name); }
+std::optional<BottomProfile> bottom_profile_from(std::string_view name) { return value_of(kProfileNames, name); }
+
+std::optional<std::string> ToolSpec::problem() const {
+  auto positive = [](const char* key, double v) -> std::optional<std::string> {
+    if (v > 0.0) return std::nullopt;
+    return std::string(key) + " = " + number(v) + " must be > 0";
+  };
+  std::optional<std::string> p;
+  if (shape == ToolShape::Disk || shape == ToolShape::Pour) p = positive("tool.radius_m", radius_m);
+  if (!p && (shape == ToolShape::Box || shape == ToolShape::Ellipse))
+    p = positive("tool.size_m", half_size_m.minCoeff());
+  if (!p && (shape == ToolShape::Disk || shape == ToolShape::Ellipse) && (sides < 3 || sides > 4096))
+    p = "tool.sides = " + std::to_string(sides) + " must be in [3, 4096]";
+  if (!p && shape == ToolShape::Polygon && (polygon_m.size() < 3 || !is_simple_polygon(polygon_m)))
+    p = "tool.polygon_m must be a simple polygon of at least 3 points";
+  if (!p && shape == ToolShape::Pour) p = positive("tool.volume_m3", pour_volume_m3);
+  if (!p && shape != ToolShape::Pour && profile == BottomProfile::SphereCap)
+    p = positive("tool.sphere_radius_m", sphere_radius_m);
+  if (!p && !(rim.width_m >= 0.0)) p = "tool.rim_width_m = " + number(rim.width_m) + " must be >= 0";
+  if (!p && !(rim.forward_bias >= 0.0 && rim.forward_bias <= 1.0))
+    p = "tool.rim_forward_bias = " + number(rim.forward_bias) + " must be in [0, 1]";
+  return p;
+}
 
 std::vector<Vec2> ToolSpec::footprint_local() const {
   std::vector<Vec2> poly;

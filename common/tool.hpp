@@ -2,7 +2,9 @@
 // Tools: a footprint polygon plus a bottom profile, posed in the world; and the pour tool.
 // A ToolStamp is one application of a tool at one pose: the unit the back-ends consume.
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "common/geometry.hpp"
@@ -12,8 +14,11 @@ namespace sb {
 enum class ToolShape { Disk, Box, Ellipse, Polygon, Pour };
 enum class BottomProfile { Flat, SphereCap };
 
+// Names as in scene files and sessions ("disk", "sphere_cap"), one table each way.
 std::string to_string(ToolShape s);
 std::string to_string(BottomProfile p);
+std::optional<ToolShape> tool_shape_from(std::string_view name);          // disk | box | ellipse | polygon | pour
+std::optional<BottomProfile> bottom_profile_from(std::string_view name);  // flat | sphere_cap
 
 // Where the displaced volume goes: a rim band just outside the footprint, weighted
 // towards the direction of motion (Sumner et al. 1999; Onoue & Nishita 2003).
@@ -33,6 +38,11 @@ struct ToolSpec {
   double depth_m = 0.01;          // bottom depth below the initial surface
   double pour_volume_m3 = 0.0;    // pour tool: volume added per stamp
   RimRule rim;
+
+  // What is wrong with the fields the shape uses, named as scene keys ("tool.radius_m = 0
+  // must be > 0"); nullopt when the tool is usable. Scenes check their keys with their own
+  // ranges first; sessions, which carry whole tools, rely on this. O(polygon^2).
+  std::optional<std::string> problem() const;
 
   // Footprint in tool coordinates (origin at the pose, x along the heading), CCW.
   // Empty for the pour tool, which has no footprint.

@@ -106,11 +106,29 @@ def write_csv(keys, path, rate_hz):
             f.write(f"{t:.6f},{x:.9f},{y:.9f},{z:.9f},{b}\n")
 
 
-def play(keys, port, rate_hz, duration_s, settle_s):
+def wait_for_answer(sock, target, keys, deadline_s):
+    """Sends the first pose every 10 ms until sandbench answers with a force packet (it is up
+    and listening), so nothing depends on how long its start takes; exits after deadline_s."""
+    (x, y, z), buttons = pose_at(keys, 0.0)
+    start = time.monotonic()
+    while time.monotonic() - start < deadline_s:
+        sock.sendto(POSE.pack(POSE_MAGIC, 0, 0.0, x, y, z, buttons, 0), target)
+        if select.select([sock], [], [], 0.01)[0]:
+            try:
+                if len(sock.recv(64)) == FORCE.size:
+                    return
+            except ConnectionRefusedError:
+                time.sleep(0.01)  # nobody listens yet
+    sys.exit(f"udp_device: no answer from 127.0.0.1:{target[1]} within {deadline_s} s")
+
+
+def play(keys, port, rate_hz, duration_s, settle_s, answer_deadline_s=0.0):
     sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
     sock.bind(("127.0.0.1", 0))
     sock.setblocking(False)
     target = ("127.0.0.1", port)
+    if answer_deadline_s > 0:
+        wait_for_answer(sock, target, keys, answer_deadline_s)
     stats = {"poses_sent": 0, "forces_received": 0, "packets_rejected": 0, "all_finite": True,
              "force_max_n": 0.0, "force_limit_n": None, "within_limit": True,
              "ticks_in_contact": 0, "ticks_clamped": 0, "ticks_stale": 0}
@@ -166,6 +184,8 @@ def main():
     ap.add_argument("--duration", type=float, default=4.0, help="seconds of motion (scene stroke)")
     ap.add_argument("--settle", type=float, default=0.3, help="seconds to keep listening afterwards")
     ap.add_argument("--wait", type=float, default=0.0, help="seconds to wait before the first pose")
+    ap.add_argument("--wait-for-answer", type=float, default=0.0, metavar="DEADLINE_S",
+                    help="before the motion, repeat the first pose until sandbench answers (give up after DEADLINE_S)")
     ap.add_argument("--hover", type=float, default=0.01, help="start and end this far above the sand, m")
     ap.add_argument("--extra-depth", type=float, default=0.0, help="press this much deeper than tool.depth_m, m")
     ap.add_argument("--write-csv", help="write the motion as a replay file and exit")
@@ -181,7 +201,7 @@ def main():
         ap.error("--port in [1, 65535] is required unless --write-csv is given")
     time.sleep(args.wait)
     duration = keys[-1][0]
-    stats = play(keys, args.port, args.rate_hz, duration, args.settle)
+    stats = play(keys, args.port, args.rate_hz, duration, args.settle, args.wait_for_answer)
     text = json.dumps(stats, indent=2)
     if args.out:
         with open(args.out, "w") as f:

@@ -36,7 +36,7 @@ struct ServoSample {
   double penetration_m = 0.0;
 };
 
-// The haptic statistics of DESIGN.md (servo_hz, tick_us.*, missed_deadlines, force_max_n)
+// The haptic statistics of README "Interactive mode and haptics" (servo_hz, tick_us.*, missed_deadlines, force_max_n)
 // and a few more.
 struct ServoStats {
   std::uint64_t ticks = 0;

@@ -1,5 +1,5 @@
 #pragma once
-// A recorded device trajectory: the replay file of DESIGN.md, CSV with the header
+// A recorded device trajectory: the replay file of README "Interactive mode and haptics", CSV with the header
 // t,x,y,z,buttons (seconds, metres, bit mask). Other tables after it (a session's tools and
 // stamps) are ignored here. Parsing and writing are O(samples).
 #include <cstdint>

@@ -106,9 +106,8 @@ void compare_command(const CompareOptions& o) {
   if (!dir.empty()) {
     for (const auto& r : runs)
       write_run_file(dir / default_run_path(o.scene, r.run.label).filename(), r.run, r.prepared, r.summary);
-    write_atomically(dir / "summary.json",
-                     [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << report.dump(2) << "\n"; });
-    write_atomically(dir / "table.md", [&](const std::filesystem::path& tmp) { std::ofstream(tmp) << table; });
+    write_text_atomically(dir / "summary.json", report.dump(2) + "\n");
+    write_text_atomically(dir / "table.md", table);
     std::vector<PictureRun> pictures;
     for (const auto& r : runs)
       pictures.push_back({r.run.label, &r.run.final_mesh, &r.run.initial_raster, &r.run.final_raster, &r.summary});

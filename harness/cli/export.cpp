@@ -7,6 +7,7 @@
 
 #include "common/input_error.hpp"
 #include "harness/cli/commands.hpp"
+#include "harness/cli/validators.hpp"
 #include "harness/io/run_file.hpp"
 #include "harness/render/mesh.hpp"
 #include "sandbench/version.hpp"
@@ -16,7 +17,7 @@ namespace sb::cli {
 namespace {
 struct ExportOptions {
   std::string run;
-  std::string format;
+  ExportFormat format = ExportFormat::Ply;
   std::string out;
 };
 
@@ -26,11 +27,8 @@ std::string attribute(const RunFile& r, const char* key) {
 }
 
 void export_command(const ExportOptions& o) {
-  const ExportFormat format = parse_export_format(o.format);
+  const ExportFormat format = o.format;
   const std::filesystem::path out = o.out;
-  if (out.has_parent_path() && !std::filesystem::is_directory(out.parent_path()))
-    throw InputError("-o " + out.string() + ": directory " + out.parent_path().string() + " does not exist");
-  if (std::filesystem::is_directory(out)) throw InputError("-o " + out.string() + " is a directory; give a file name");
   const RunFile run = read_run_file(o.run);
   const std::string label = attribute(run, "label").empty() ? attribute(run, "backend") : attribute(run, "label");
   const std::vector<std::string> comments = {
@@ -59,8 +57,8 @@ void add_export_command(CLI::App& app) {
   CLI::App* cmd =
       app.add_subcommand("export", "Export a run file's final surface as PLY, OBJ or a 16-bit PNG heightmap");
   cmd->add_option("run", opts->run, "Run file (HDF5) written by sandbench run or compare")->required();
-  cmd->add_option("--format", opts->format, "ply | obj | png16")->required();
-  cmd->add_option("-o,--out", opts->out, "File to write")->required();
+  cmd->add_option("--format", opts->format, "ply | obj | png16")->required()->transform(names(export_formats()));
+  cmd->add_option("-o,--out", opts->out, "File to write")->required()->check(output_file());
   cmd->callback([opts] { export_command(*opts); });
 }
 

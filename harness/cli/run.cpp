@@ -4,8 +4,10 @@
 
 #include "common/input_error.hpp"
 #include "harness/cli/commands.hpp"
+#include "harness/cli/validators.hpp"
 #include "harness/io/run_file.hpp"
 #include "harness/io/session_file.hpp"
+#include "harness/run/backends.hpp"
 #include "harness/run/variant.hpp"
 
 namespace sb::cli {
@@ -37,8 +39,6 @@ void run_command(const RunOptions& o) {
   const Variant variant = parse_variant(o.backend);
   const std::filesystem::path out =
       o.out.empty() ? default_run_path(o.scene, variant.label) : std::filesystem::path(o.out);
-  if (out.has_parent_path() && !std::filesystem::is_directory(out.parent_path()))
-    throw InputError("--out " + out.string() + ": directory " + out.parent_path().string() + " does not exist");
   VariantRun r = run_variant(variant, prepared, /*show_progress=*/true);
   if (!o.replay.empty()) r.summary["replay"] = o.replay;
   write_run_file(out, r.run, r.prepared, r.summary);
@@ -55,8 +55,8 @@ void add_run_command(CLI::App& app) {
   auto opts = std::make_shared<RunOptions>();
   CLI::App* cmd = app.add_subcommand("run", "Run one back-end on a scene's stroke and write an HDF5 run file");
   cmd->add_option("scene", opts->scene, "Scene file (TOML)")->required();
-  cmd->add_option("--backend", opts->backend, "tin | grid | sparse (optionally grid:key=value:...)")->required();
-  cmd->add_option("--out", opts->out, "Run file to write (default: <scene>-<backend>.h5)");
+  cmd->add_option("--backend", opts->backend, backend_list() + " (optionally grid:key=value:...)")->required();
+  cmd->add_option("--out", opts->out, "Run file to write (default: <scene>-<backend>.h5)")->check(output_file());
   cmd->add_flag("--json", opts->json, "Print the summary as JSON on stdout");
   cmd->add_option("--set", opts->overrides, "Override a scene key: --set tool.radius_m=0.03")->take_all();
   cmd->add_option("--replay", opts->replay,

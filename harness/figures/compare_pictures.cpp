@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "harness/figures/font.hpp"
+#include "harness/figures/canvas.hpp"
 #include "harness/figures/legend.hpp"
 #include "harness/figures/picture.hpp"
 #include "harness/render/colour.hpp"
@@ -63,17 +63,19 @@ double relief(const Raster& r, const Vec2& p, const Vec3& light) {
 }
 
 // Draws a heat map of runs[a] - runs[b] over the frame's region into image at (x, y).
-void heat_map(Image& image, int x, int y, int w, int h, const Raster& a, const Raster& b, const RenderFrame& f,
+void heat_map(Canvas& image, int x, int y, int w, int h, const Raster& a, const Raster& b, const RenderFrame& f,
               double scale_m) {
   const Vec3 light = light_direction();
   const Vec2 size = f.region.hi - f.region.lo;
+  Image map(w, h);
   for (int py = 0; py < h; ++py)
     for (int px = 0; px < w; ++px) {
       const Vec2 p(f.region.lo.x() + (px + 0.5) / w * size.x(), f.region.hi.y() - (py + 0.5) / h * size.y());
       const UnitRgb c = diverging_colour((a.interpolate(p) - b.interpolate(p)) / scale_m);
       const double k = relief(b, p, light);
-      image.set(x + px, y + py, rgb_from_unit(c.r * k, c.g * k, c.b * k));
+      map.set(px, py, rgb_from_unit(c.r * k, c.g * k, c.b * k));
     }
+  image.draw_image(map, x, y);
   image.draw_rect(x - 1, y - 1, w + 2, h + 2, kInk);
   // Axes in metres.
   const double step = nice_step(std::max(size.x(), size.y()), 4);
@@ -81,13 +83,13 @@ void heat_map(Image& image, int x, int y, int w, int h, const Raster& a, const R
     const int tx = x + static_cast<int>(std::lround((k * step - f.region.lo.x()) / size.x() * (w - 1)));
     image.fill_rect(tx, y + h + 1, 1, 6, kInk);
     const std::string label = format_tick(k * step, step);
-    draw_text(image, tx - text_width(label, 2) / 2, y + h + 10, label, kInk, 2);
+    image.draw_text(tx - text_width(label, 2) / 2, y + h + 10, label, kInk, 2);
   }
   for (double k = std::ceil(f.region.lo.y() / step - 1e-9); k * step <= f.region.hi.y() + 1e-12; ++k) {
     const int ty = y + static_cast<int>(std::lround((f.region.hi.y() - k * step) / size.y() * (h - 1)));
     image.fill_rect(x - 7, ty, 6, 1, kInk);
     const std::string label = format_tick(k * step, step);
-    draw_text(image, x - 10 - text_width(label, 2), ty - 6, label, kInk, 2);
+    image.draw_text(x - 10 - text_width(label, 2), ty - 6, label, kInk, 2);
   }
 }
 }  // namespace
@@ -129,14 +131,14 @@ Image side_by_side(Renderer& renderer, const std::vector<PictureRun>& runs, cons
   const int footer_h = 2 * (text_height(2) + 6) + 8;
   const int width = 2 * kMargin + n * kPanelW + (n - 1) * kGap;
   const int height = kMargin + title_h + header_h + 2 * kPanelH + kGap + footer_h + kMargin;
-  Image image(width, height, kPaper);
+  Canvas image(width, height, kPaper);
 
   const Json& first = *runs.front().summary;
   std::string title = "sandbench compare";
   if (first.contains("scene") && first.at("scene").is_string())
     title += ": " + std::filesystem::path(first.at("scene").get<std::string>()).filename().string();
   if (first.contains("stamps")) title += ", " + std::to_string(count(first, "stamps")) + " stamps";
-  draw_text(image, kMargin, kMargin, title, kGrey, 2);
+  image.draw_text(kMargin, kMargin, title, kGrey, 2);
 
   RenderOptions oblique;
   oblique.width = kPanelW;
@@ -148,19 +150,20 @@ Image side_by_side(Renderer& renderer, const std::vector<PictureRun>& runs, cons
     const PictureRun& r = runs[static_cast<std::size_t>(i)];
     const int x = kMargin + i * (kPanelW + kGap);
     int y = kMargin + title_h;
-    draw_text(image, x, y, r.label, kInk, 3);
+    image.draw_text(x, y, r.label, kInk, 3);
     const std::vector<std::string>& caption = captions[static_cast<std::size_t>(i)];
     for (std::size_t k = 0; k < caption.size(); ++k)
-      draw_text(image, x, y + text_height(3) + 10 + static_cast<int>(k) * line_h, caption[k], kInk, 2);
+      image.draw_text(x, y + text_height(3) + 10 + static_cast<int>(k) * line_h, caption[k], kInk, 2);
     y += header_h;
-    image.blit(render_picture(renderer, *r.mesh, *r.final, frame, oblique), x, y);
-    image.blit(render_picture(renderer, *r.mesh, *r.final, frame, top), x, y + kPanelH + kGap);
+    image.draw_image(render_picture(renderer, *r.mesh, *r.final, frame, oblique), x, y);
+    image.draw_image(render_picture(renderer, *r.mesh, *r.final, frame, top), x, y + kPanelH + kGap);
   }
   const int fy = height - kMargin - footer_h + 8;
-  draw_text(image, kMargin, fy, "Top row: oblique view, smooth shaded; one camera, light and sand for all.", kGrey, 2);
-  draw_text(image, kMargin, fy + text_height(2) + 6,
-            "Bottom row: top view with mesh edges (red: constrained). Region " + region_text(frame) + ".", kGrey, 2);
-  return image;
+  image.draw_text(kMargin, fy, "Top row: oblique view, smooth shaded; one camera, light and sand for all.", kGrey, 2);
+  image.draw_text(kMargin, fy + text_height(2) + 6,
+                  "Bottom row: top view with mesh edges (red: constrained). Region " + region_text(frame) + ".", kGrey,
+                  2);
+  return image.image();
 }
 
 Image difference_map(const std::vector<PictureRun>& runs, const RenderFrame& frame) {
@@ -200,26 +203,26 @@ Image difference_map(const std::vector<PictureRun>& runs, const RenderFrame& fra
   const int panel_w = left + map_w + kGap;
   const int width = 2 * kMargin + panels * panel_w + bar_box.width + kGap;
   const int height = kMargin + title_h + head_h + map_h + bottom + footer_h + kMargin;
-  Image image(width, height, kPaper);
-  draw_text(image, kMargin, kMargin, "Height difference on the common raster (" + metres(base.spacing_m) + " spacing)",
-            kGrey, 2);
+  Canvas image(width, height, kPaper);
+  image.draw_text(kMargin, kMargin, "Height difference on the common raster (" + metres(base.spacing_m) + " spacing)",
+                  kGrey, 2);
   const int map_y = kMargin + title_h + head_h;
   for (int i = 0; i < panels; ++i) {
     const PictureRun& a = runs[static_cast<std::size_t>(i) + 1];
     const RasterDifference d = compare_rasters(*a.final, base);
     const int x = kMargin + i * panel_w + left;
-    draw_text(image, x, kMargin + title_h, a.label + " - " + runs.front().label, kInk, 3);
-    draw_text(image, x, kMargin + title_h + text_height(3) + 6,
-              "RMSE " + metres(d.rmse_m) + ", max |d| " + metres(d.max_abs_m), kInk, 2);
+    image.draw_text(x, kMargin + title_h, a.label + " - " + runs.front().label, kInk, 3);
+    image.draw_text(x, kMargin + title_h + text_height(3) + 6,
+                    "RMSE " + metres(d.rmse_m) + ", max |d| " + metres(d.max_abs_m), kInk, 2);
     heat_map(image, x, map_y, map_w, map_h, *a.final, base, frame, scale_m);
-    draw_text(image, x + map_w / 2 - text_width("x (m)", 2) / 2, map_y + map_h + text_height(2) + 16, "x (m)", kGrey,
-              2);
-    draw_text(image, x - left + 4, map_y - text_height(2) - 4, "y (m)", kGrey, 2);
+    image.draw_text(x + map_w / 2 - text_width("x (m)", 2) / 2, map_y + map_h + text_height(2) + 16, "x (m)", kGrey, 2);
+    image.draw_text(x - left + 4, map_y - text_height(2) - 4, "y (m)", kGrey, 2);
   }
   draw_colour_bar(image, kMargin + panels * panel_w, map_y, bar, map_h * 3 / 4, 2, false);
-  draw_text(image, kMargin, height - kMargin - text_height(2),
-            "RMSE and max |d| over the whole raster; grey relief: " + runs.front().label + "'s surface.", kGrey, 2);
-  return image;
+  image.draw_text(kMargin, height - kMargin - text_height(2),
+                  "RMSE and max |d| over the whole raster; grey relief: " + runs.front().label + "'s surface.", kGrey,
+                  2);
+  return image.image();
 }
 
 std::vector<std::filesystem::path> write_compare_pictures(const std::filesystem::path& dir,

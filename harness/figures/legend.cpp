@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "harness/figures/font.hpp"
 #include "harness/render/colour.hpp"
 
 namespace sb {
@@ -35,14 +34,14 @@ BoxSize colour_bar_size(const ColourBar& bar, int bar_height, int scale) {
   return {width + 2 * kPad, height + 2 * kPad};
 }
 
-void draw_colour_bar(Image& image, int x, int y, const ColourBar& bar, int bar_height, int scale, bool backdrop) {
+void draw_colour_bar(Canvas& image, int x, int y, const ColourBar& bar, int bar_height, int scale, bool backdrop) {
   const BoxSize box = colour_bar_size(bar, bar_height, scale);
   if (backdrop) {
     image.fill_rect(x, y, box.width, box.height, {255, 255, 255});
     image.draw_rect(x, y, box.width, box.height, {160, 160, 160});
   }
   const int line = text_height(scale) + 2 * scale;
-  draw_text(image, x + kPad, y + kPad, bar.title, kInk, scale);
+  image.draw_text(x + kPad, y + kPad, bar.title, kInk, scale);
   const int bx = x + kPad, by = y + kPad + line + text_height(scale) / 2, bw = bar_width(scale);
   for (int row = 0; row < bar_height; ++row) {
     const double v = bar.hi - (bar.hi - bar.lo) * (row + 0.5) / bar_height;
@@ -57,10 +56,10 @@ void draw_colour_bar(Image& image, int x, int y, const ColourBar& bar, int bar_h
   for (double t : ticks(bar)) {
     const int ty = by + static_cast<int>(std::lround((bar.hi - t) / (bar.hi - bar.lo) * (bar_height - 1)));
     image.fill_rect(bx + bw, ty, 3 * scale, std::max(1, scale / 2), kInk);
-    draw_text(image, bx + bw + 4 * scale, ty - 3 * scale, format_tick(t, bar.tick_step, bar.plus_sign), kInk, scale);
+    image.draw_text(bx + bw + 4 * scale, ty - 3 * scale, format_tick(t, bar.tick_step, bar.plus_sign), kInk, scale);
   }
   if (!bar.note.empty())
-    draw_text(image, x + kPad, by + bar_height + text_height(scale) / 2 + 2 * scale, bar.note, kInk, scale);
+    image.draw_text(x + kPad, by + bar_height + text_height(scale) / 2 + 2 * scale, bar.note, kInk, scale);
 }
 
 }  // namespace sb

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "harness/render/image.hpp"
+#include "harness/figures/canvas.hpp"
 
 namespace sb {
 
@@ -26,6 +26,6 @@ struct BoxSize {
 // The box a bar of `bar_height` pixels takes with its labels, text at `scale`.
 BoxSize colour_bar_size(const ColourBar& bar, int bar_height, int scale);
 // Draws the bar's box with its top-left corner at (x, y); `backdrop` fills it with white first.
-void draw_colour_bar(Image& image, int x, int y, const ColourBar& bar, int bar_height, int scale, bool backdrop);
+void draw_colour_bar(Canvas& image, int x, int y, const ColourBar& bar, int bar_height, int scale, bool backdrop);
 
 }  // namespace sb

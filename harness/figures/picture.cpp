@@ -29,8 +29,9 @@ Image render_picture(Renderer& renderer, const SurfaceMesh& mesh, const Raster& 
   const int bar_h = std::max(40, image.height() / 4);
   const BoxSize box = colour_bar_size(bar, bar_h, scale);
   if (box.width + 8 > image.width() || box.height + 8 > image.height()) return image;  // too small for a legend
-  draw_colour_bar(image, image.width() - box.width - 8, image.height() - box.height - 8, bar, bar_h, scale, true);
-  return image;
+  Canvas canvas(image);
+  draw_colour_bar(canvas, image.width() - box.width - 8, image.height() - box.height - 8, bar, bar_h, scale, true);
+  return canvas.image();
 }
 
 }  // namespace sb

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "common/format.hpp"
 #include "common/metrics.hpp"
 
 namespace sb {
@@ -17,9 +18,7 @@ constexpr std::size_t kRecentSteps = 256;
 double patch_margin(double reach_m) { return std::max(0.015, 0.5 * reach_m); }
 
 std::string material_override(const char* key, double v) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "material.%s=%.17g", key, v);
-  return buf;
+  return "material." + std::string(key) + "=" + exact_number(v);
 }
 
 }  // namespace

@@ -67,12 +67,7 @@ Json haptic_stats_json(const haptics::ServoStats& s, const haptics::DeviceLimits
 }
 
 void write_json_file(const std::filesystem::path& file, const Json& json) {
-  write_atomically(file, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out << json.dump(2) << "\n";
-    out.flush();
-    if (!out) throw std::runtime_error("writing " + tmp.string() + " failed");
-  });
+  write_text_atomically(file, json.dump(2) + "\n");
 }
 
 }  // namespace sb

@@ -1,6 +1,6 @@
 #pragma once
 // The haptic statistics file of `sandbench interactive --stats FILE`: the contract keys of
-// DESIGN.md (servo_hz, tick_us.p50, tick_us.p99, tick_us.max, missed_deadlines,
+// README "Interactive mode and haptics" (servo_hz, tick_us.p50, tick_us.p99, tick_us.max, missed_deadlines,
 // force_max_n) first, then the limits, the simulation's figures and bookkeeping.
 #include <filesystem>
 #include <string>

@@ -12,6 +12,7 @@
 // Each file is written whole or not at all. Costs: O(V + T log T) for PLY (edges),
 // O(V + T) for OBJ, O(raster points) for PNG16.
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -23,8 +24,8 @@
 namespace sb {
 
 enum class ExportFormat { Ply, Obj, Png16 };
-// Throws InputError naming --format for anything but ply, obj or png16.
-ExportFormat parse_export_format(const std::string& text);
+// The formats by name: ply, obj, png16.
+const std::map<std::string, ExportFormat>& export_formats();
 
 // `comments`: one line each (newlines become spaces), e.g. the back-end and the scene.
 void export_ply(const std::filesystem::path& file, const SurfaceMesh& mesh, const std::vector<std::string>& comments);

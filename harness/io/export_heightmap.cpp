@@ -5,21 +5,16 @@
 #include <stdexcept>
 
 #include "common/atomic_file.hpp"
+#include "common/format.hpp"
 #include "harness/io/export.hpp"
 
 namespace sb {
 
 namespace {
-// Shortest text that reads back as the same double ("0.0025", not "0.0025000000000000001").
-std::string number(double v) {
-  char buf[40];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
 
 std::string pair(const Vec2& v) {
   std::string out = "[";
-  out.append(number(v.x())).append(", ").append(number(v.y())).append("]");
+  out.append(exact_number(v.x())).append(", ").append(exact_number(v.y())).append("]");
   return out;
 }
 
@@ -72,8 +67,8 @@ Png16 quantise(const Raster& r, const HeightmapKeys& k) {
 
 std::string heightmap_scene_snippet(const HeightmapKeys& k, const std::string& png_name) {
   return "[domain]\norigin_m = " + pair(k.origin_m) + "\nsize_m = " + pair(k.size_m) +
-         "\n\n[terrain]\nkind = \"heightmap\"\npath = \"" + png_name + "\"\nheight_m = " + number(k.height_m) +
-         "\nvertical_scale_m = " + number(k.vertical_scale_m) + "\n";
+         "\n\n[terrain]\nkind = \"heightmap\"\npath = \"" + png_name + "\"\nheight_m = " + exact_number(k.height_m) +
+         "\nvertical_scale_m = " + exact_number(k.vertical_scale_m) + "\n";
 }
 
 HeightmapKeys export_png16(const std::filesystem::path& file, const Raster& raster, const std::string& source) {
@@ -82,21 +77,17 @@ HeightmapKeys export_png16(const std::filesystem::path& file, const Raster& rast
   const double s = raster.spacing_m;
   // GDAL's sidecar: pixel-is-area georeference (pixel centres on the raster points), and the
   // scale and offset that turn values into metres.
-  const std::string aux = "<PAMDataset>\n  <GeoTransform>" + number(k.origin_m.x() - s / 2) + ", " + number(s) +
-                          ", 0, " + number(k.origin_m.y() + k.size_m.y() + s / 2) + ", 0, " + number(-s) +
-                          "</GeoTransform>\n  <Metadata>\n    <MDI key=\"source\">" + xml_escape(source) +
+  const std::string aux = "<PAMDataset>\n  <GeoTransform>" + exact_number(k.origin_m.x() - s / 2) + ", " +
+                          exact_number(s) + ", 0, " + exact_number(k.origin_m.y() + k.size_m.y() + s / 2) + ", 0, " +
+                          exact_number(-s) + "</GeoTransform>\n  <Metadata>\n    <MDI key=\"source\">" +
+                          xml_escape(source) +
                           "</MDI>\n  </Metadata>\n  <PAMRasterBand band=\"1\">\n    <Description>height</Description>\n"
                           "    <UnitType>m</UnitType>\n    <Offset>" +
-                          number(k.height_m) + "</Offset>\n    <Scale>" + number(k.step_m()) +
+                          exact_number(k.height_m) + "</Offset>\n    <Scale>" + exact_number(k.step_m()) +
                           "</Scale>\n  </PAMRasterBand>\n</PAMDataset>\n";
   std::filesystem::path aux_file = file;
   aux_file += ".aux.xml";
-  write_atomically(aux_file, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp);
-    out << aux;
-    out.close();
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
-  });
+  write_text_atomically(aux_file, aux);
   try {
     write_png16(file, png,
                 {{"Software", "sandbench"},
@@ -106,8 +97,8 @@ HeightmapKeys export_png16(const std::filesystem::path& file, const Raster& rast
                   "column 0 at origin x, row 0 at origin y + size y (maximum y)"},
                  {"sandbench.origin_m", pair(k.origin_m)},
                  {"sandbench.size_m", pair(k.size_m)},
-                 {"sandbench.height_m", number(k.height_m)},
-                 {"sandbench.vertical_scale_m", number(k.vertical_scale_m)},
+                 {"sandbench.height_m", exact_number(k.height_m)},
+                 {"sandbench.vertical_scale_m", exact_number(k.vertical_scale_m)},
                  {"sandbench.scene", heightmap_scene_snippet(k, file.filename().string())}});
   } catch (...) {
     std::error_code ignored;

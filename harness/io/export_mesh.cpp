@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "common/atomic_file.hpp"
+#include "common/format.hpp"
 #include "common/input_error.hpp"
 #include "harness/io/export.hpp"
 
@@ -74,27 +75,12 @@ void put(std::string& out, T v) {
   out.append(bytes, sizeof(T));
 }
 
-void append_number(std::string& out, double v) {
-  char buf[32];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  out.append(buf, r.ptr);
-}
-
-void write_string(const std::filesystem::path& file, const std::string& data) {
-  write_atomically(file, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(data.data(), static_cast<std::streamsize>(data.size()));
-    out.close();
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
-  });
-}
 }  // namespace
 
-ExportFormat parse_export_format(const std::string& text) {
-  if (text == "ply") return ExportFormat::Ply;
-  if (text == "obj") return ExportFormat::Obj;
-  if (text == "png16") return ExportFormat::Png16;
-  throw InputError("--format \"" + text + "\": must be ply, obj or png16");
+const std::map<std::string, ExportFormat>& export_formats() {
+  static const std::map<std::string, ExportFormat> table = {
+      {"ply", ExportFormat::Ply}, {"obj", ExportFormat::Obj}, {"png16", ExportFormat::Png16}};
+  return table;
 }
 
 void export_ply(const std::filesystem::path& file, const SurfaceMesh& mesh, const std::vector<std::string>& comments) {
@@ -123,7 +109,7 @@ void export_ply(const std::filesystem::path& file, const SurfaceMesh& mesh, cons
     put(out, static_cast<std::int32_t>(e.b));
     put(out, e.constrained);
   }
-  write_string(file, out);
+  write_text_atomically(file, out);
 }
 
 void export_obj(const std::filesystem::path& file, const SurfaceMesh& mesh, const std::vector<std::string>& comments) {
@@ -137,11 +123,11 @@ void export_obj(const std::filesystem::path& file, const SurfaceMesh& mesh, cons
   out.reserve(out.size() + 40 * mesh.vertices.size() + 24 * triangles.size());
   for (const Vec3& p : mesh.vertices) {
     out += "v ";
-    append_number(out, p.x());
+    out += exact_number(p.x());
     out += ' ';
-    append_number(out, p.y());
+    out += exact_number(p.y());
     out += ' ';
-    append_number(out, p.z());
+    out += exact_number(p.z());
     out += '\n';
   }
   for (const auto& t : triangles)
@@ -154,7 +140,7 @@ void export_obj(const std::filesystem::path& file, const SurfaceMesh& mesh, cons
       out += "l " + std::to_string(e[0] + 1) + " " + std::to_string(e[1] + 1) + "\n";
     }
   }
-  write_string(file, out);
+  write_text_atomically(file, out);
 }
 
 }  // namespace sb

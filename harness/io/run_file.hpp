@@ -1,5 +1,5 @@
 #pragma once
-// HDF5 run files (DESIGN.md contract): one file per back-end run, written under a temporary
+// HDF5 run files (contract: README "Run files (HDF5)"): one file per back-end run, written under a temporary
 // name and renamed when whole.
 //   /                   attributes: scene_text, scene_resolved, scene_path, overrides,
 //                       backend, label, parameters, version, compiler, date, summary (JSON)

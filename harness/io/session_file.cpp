@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "common/atomic_file.hpp"
+#include "common/format.hpp"
 #include "common/haptics/csv_tables.hpp"
 #include "common/input_error.hpp"
 
@@ -27,23 +28,17 @@ const std::vector<std::string> kToolHeader{
 const std::vector<std::string> kStampHeader{"stamp",       "t",     "x",     "y",   "bottom_z",
                                             "heading_rad", "dir_x", "dir_y", "tool"};
 
-std::string num(double v) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
-
 // A tool's row without its index.
 std::string tool_fields(const ToolSpec& t) {
   std::string poly;
   for (const Vec2& p : t.polygon_m) {
     if (!poly.empty()) poly += ' ';
-    poly.append(num(p.x())).append(" ").append(num(p.y()));
+    poly.append(exact_number(p.x())).append(" ").append(exact_number(p.y()));
   }
-  return to_string(t.shape) + "," + num(t.radius_m) + "," + num(2.0 * t.half_size_m.x()) + "," +
-         num(2.0 * t.half_size_m.y()) + "," + std::to_string(t.sides) + "," + to_string(t.profile) + "," +
-         num(t.sphere_radius_m) + "," + num(t.depth_m) + "," + num(t.rim.width_m) + "," + num(t.rim.forward_bias) +
-         "," + num(t.pour_volume_m3) + "," + poly;
+  return to_string(t.shape) + "," + exact_number(t.radius_m) + "," + exact_number(2.0 * t.half_size_m.x()) + "," +
+         exact_number(2.0 * t.half_size_m.y()) + "," + std::to_string(t.sides) + "," + to_string(t.profile) + "," +
+         exact_number(t.sphere_radius_m) + "," + exact_number(t.depth_m) + "," + exact_number(t.rim.width_m) + "," +
+         exact_number(t.rim.forward_bias) + "," + exact_number(t.pour_volume_m3) + "," + poly;
 }
 
 std::string join(const std::vector<std::string>& v) {
@@ -52,48 +47,25 @@ std::string join(const std::vector<std::string>& v) {
   return s;
 }
 
+// A tool's row; the fields are checked by ToolSpec::problem(), as for every tool.
 ToolSpec read_tool(const CsvFile& f, const CsvTable& t, std::size_t r) {
   ToolSpec tool;
-  const std::string& shape = t.rows[r][1];
   const int line = t.lines[r];
-  if (shape == "disk")
-    tool.shape = ToolShape::Disk;
-  else if (shape == "box")
-    tool.shape = ToolShape::Box;
-  else if (shape == "ellipse")
-    tool.shape = ToolShape::Ellipse;
-  else if (shape == "polygon")
-    tool.shape = ToolShape::Polygon;
-  else if (shape == "pour")
-    tool.shape = ToolShape::Pour;
-  else
-    csv_fail(f, line, "column shape = '" + shape + "' must be disk | box | ellipse | polygon | pour");
-  auto positive = [&](std::size_t col) {
-    const double v = csv_number(f, t, r, col);
-    if (!(v > 0.0)) csv_fail(f, line, "column " + t.header[col] + " = " + t.rows[r][col] + " must be > 0");
-    return v;
-  };
-  tool.radius_m = positive(2);
-  tool.half_size_m = Vec2(positive(3), positive(4)) / 2.0;
+  const auto shape = tool_shape_from(t.rows[r][1]);
+  if (!shape) csv_fail(f, line, "column shape = '" + t.rows[r][1] + "' must be disk | box | ellipse | polygon | pour");
+  tool.shape = *shape;
+  tool.radius_m = csv_number(f, t, r, 2);
+  tool.half_size_m = Vec2(csv_number(f, t, r, 3), csv_number(f, t, r, 4)) / 2.0;
   const std::size_t sides = csv_index(f, t, r, 5);
-  if (sides < 3 || sides > 4096) csv_fail(f, line, "column sides = " + t.rows[r][5] + " must be in [3, 4096]");
-  tool.sides = static_cast<int>(sides);
-  const std::string& profile = t.rows[r][6];
-  if (profile == "flat")
-    tool.profile = BottomProfile::Flat;
-  else if (profile == "sphere_cap")
-    tool.profile = BottomProfile::SphereCap;
-  else
-    csv_fail(f, line, "column profile = '" + profile + "' must be flat | sphere_cap");
-  tool.sphere_radius_m = positive(7);
+  tool.sides = static_cast<int>(std::min<std::size_t>(sides, 1u << 30));
+  const auto profile = bottom_profile_from(t.rows[r][6]);
+  if (!profile) csv_fail(f, line, "column profile = '" + t.rows[r][6] + "' must be flat | sphere_cap");
+  tool.profile = *profile;
+  tool.sphere_radius_m = csv_number(f, t, r, 7);
   tool.depth_m = csv_number(f, t, r, 8);
   tool.rim.width_m = csv_number(f, t, r, 9);
   tool.rim.forward_bias = csv_number(f, t, r, 10);
-  if (tool.rim.width_m < 0.0 || tool.rim.forward_bias < 0.0 || tool.rim.forward_bias > 1.0)
-    csv_fail(f, line, "columns rim_width_m >= 0 and rim_forward_bias in [0, 1] required");
   tool.pour_volume_m3 = csv_number(f, t, r, 11);
-  if (tool.shape == ToolShape::Pour && !(tool.pour_volume_m3 > 0.0))
-    csv_fail(f, line, "column pour_volume_m3 must be > 0 for a pour tool");
   std::istringstream poly(t.rows[r][12]);
   std::vector<double> xy;
   for (std::string w; poly >> w;) {
@@ -104,8 +76,7 @@ ToolSpec read_tool(const CsvFile& f, const CsvTable& t, std::size_t r) {
   }
   if (xy.size() % 2 != 0) csv_fail(f, line, "column polygon_m must hold x y pairs");
   for (std::size_t i = 0; i < xy.size(); i += 2) tool.polygon_m.emplace_back(xy[i], xy[i + 1]);
-  if (tool.shape == ToolShape::Polygon && (tool.polygon_m.size() < 3 || !is_simple_polygon(tool.polygon_m)))
-    csv_fail(f, line, "column polygon_m must be a simple polygon of at least 3 points");
+  if (const auto problem = tool.problem()) csv_fail(f, line, *problem);
   return tool;
 }
 
@@ -132,17 +103,18 @@ void write_session(const std::filesystem::path& file, const Session& s) {
     if (!s.forces.empty()) {
       out << join(kForceHeader) << "\n";
       for (const SessionForce& f : s.forces)
-        out << num(f.t_s) << "," << num(f.force_n.x()) << "," << num(f.force_n.y()) << "," << num(f.force_n.z()) << ","
-            << num(f.penetration_m) << "\n";
+        out << exact_number(f.t_s) << "," << exact_number(f.force_n.x()) << "," << exact_number(f.force_n.y()) << ","
+            << exact_number(f.force_n.z()) << "," << exact_number(f.penetration_m) << "\n";
     }
     out << join(kToolHeader) << "\n";
     for (std::size_t i = 0; i < s.tools.size(); ++i) out << i << "," << tool_fields(s.tools[i]) << "\n";
     out << join(kStampHeader) << "\n";
     for (std::size_t i = 0; i < s.stamps.size(); ++i) {
       const SessionStamp& st = s.stamps[i];
-      out << i << "," << num(st.t_s) << "," << num(st.pose.xy.x()) << "," << num(st.pose.xy.y()) << ","
-          << num(st.pose.bottom_z) << "," << num(st.pose.heading_rad) << "," << num(st.motion_dir.x()) << ","
-          << num(st.motion_dir.y()) << "," << st.tool << "\n";
+      out << i << "," << exact_number(st.t_s) << "," << exact_number(st.pose.xy.x()) << ","
+          << exact_number(st.pose.xy.y()) << "," << exact_number(st.pose.bottom_z) << ","
+          << exact_number(st.pose.heading_rad) << "," << exact_number(st.motion_dir.x()) << ","
+          << exact_number(st.motion_dir.y()) << "," << st.tool << "\n";
     }
     out.flush();
     if (!out) throw std::runtime_error("writing " + tmp.string() + " failed");

@@ -4,7 +4,7 @@
 // its header line, after '#' comment lines:
 //   # sandbench session 1 / # scene: ... / # backend: ... / # set key=value (scene overrides
 //     the session made, e.g. material sliders; replay applies them before its own --set)
-//   t,x,y,z,buttons                 the device trajectory (the replay format of DESIGN.md)
+//   t,x,y,z,buttons                 the device trajectory (README: the replay format)
 //   t,fx,fy,fz,penetration_m        the force sent at each of those ticks
 //   tool,shape,radius_m,...         every tool used, in full
 //   stamp,t,x,y,bottom_z,heading_rad,dir_x,dir_y,tool   every stamp applied, in order

@@ -14,13 +14,6 @@ std::uint8_t to_byte(double v) { return static_cast<std::uint8_t>(std::lround(st
 
 Rgb rgb_from_unit(double r, double g, double b) { return {to_byte(r), to_byte(g), to_byte(b)}; }
 
-Rgb mix(const Rgb& a, const Rgb& b, double t) {
-  auto m = [t](std::uint8_t x, std::uint8_t y) {
-    return static_cast<std::uint8_t>(std::lround(x + (static_cast<double>(y) - x) * std::clamp(t, 0.0, 1.0)));
-  };
-  return {m(a.r, b.r), m(a.g, b.g), m(a.b, b.b)};
-}
-
 Image::Image(int width, int height, Rgb fill) : width_(width), height_(height) {
   if (width <= 0 || height <= 0) throw std::invalid_argument("Image: size must be positive");
   rgb_.resize(static_cast<std::size_t>(width) * height * 3);
@@ -42,30 +35,6 @@ void Image::set(int x, int y, const Rgb& c) {
   rgb_[i] = c.r;
   rgb_[i + 1] = c.g;
   rgb_[i + 2] = c.b;
-}
-
-void Image::blend(int x, int y, const Rgb& c, double alpha) {
-  if (x < 0 || y < 0 || x >= width_ || y >= height_) return;
-  set(x, y, mix(at(x, y), c, alpha));
-}
-
-void Image::fill_rect(int x, int y, int w, int h, const Rgb& c) {
-  const int x0 = std::max(0, x), y0 = std::max(0, y);
-  const int x1 = std::min(width_, x + w), y1 = std::min(height_, y + h);
-  for (int yy = y0; yy < y1; ++yy)
-    for (int xx = x0; xx < x1; ++xx) set(xx, yy, c);
-}
-
-void Image::draw_rect(int x, int y, int w, int h, const Rgb& c) {
-  fill_rect(x, y, w, 1, c);
-  fill_rect(x, y + h - 1, w, 1, c);
-  fill_rect(x, y, 1, h, c);
-  fill_rect(x + w - 1, y, 1, h, c);
-}
-
-void Image::blit(const Image& src, int x, int y) {
-  for (int sy = 0; sy < src.height(); ++sy)
-    for (int sx = 0; sx < src.width(); ++sx) set(x + sx, y + sy, src.at(sx, sy));
 }
 
 double Image::luminance(int x, int y) const {

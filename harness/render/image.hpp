@@ -1,8 +1,7 @@
 #pragma once
-// Image: an 8-bit RGB picture, row 0 at the top, with the few compositing operations the
-// renderer and the comparison pictures need (fill, blit, box downsampling, PNG output).
-// Every operation is O(pixels touched); nothing depends on time or locale, so the same
-// drawing calls give the same bytes.
+// Image: an 8-bit RGB picture, row 0 at the top: what the renderer reads back, box
+// downsampling and PNG output. Figures are composed on a Canvas (harness/figures/canvas.hpp).
+// Every operation is O(pixels touched); nothing depends on time or locale.
 #include <cstdint>
 #include <filesystem>
 #include <vector>
@@ -16,8 +15,6 @@ struct Rgb {
 
 // Rgb from linear components in [0, 1] (clamped, rounded).
 Rgb rgb_from_unit(double r, double g, double b);
-// a + (b - a) * t, per channel, t in [0, 1].
-Rgb mix(const Rgb& a, const Rgb& b, double t);
 
 class Image {
  public:
@@ -28,11 +25,6 @@ class Image {
   int height() const { return height_; }
   Rgb at(int x, int y) const;
   void set(int x, int y, const Rgb& c);  // ignored outside the image
-  // Blends c over the pixel with opacity alpha in [0, 1]; ignored outside the image.
-  void blend(int x, int y, const Rgb& c, double alpha);
-  void fill_rect(int x, int y, int w, int h, const Rgb& c);  // clipped to the image
-  void draw_rect(int x, int y, int w, int h, const Rgb& c);  // 1-pixel outline
-  void blit(const Image& src, int x, int y);                 // clipped to the image
   // Luminance (Rec. 709 weights on the stored values), in [0, 1].
   double luminance(int x, int y) const;
   const std::vector<std::uint8_t>& bytes() const { return rgb_; }

@@ -14,14 +14,13 @@
 #include <string>
 #include <vector>
 
+#include "harness/render/camera.hpp"
 #include "harness/render/colour.hpp"
 #include "harness/render/mesh.hpp"
 
 namespace sb {
 
 namespace {
-using Mat4 = Eigen::Matrix4d;
-
 constexpr double kDeg = std::numbers::pi / 180.0;
 constexpr double kViewBearingDeg = 160.0;  // camera position, clockwise from north (+y)
 constexpr double kViewElevationDeg = 40.0;
@@ -34,7 +33,7 @@ constexpr double kSkirtAmbient = 0.6;  // the walls face away from the light on 
 constexpr float kEdge[4] = {0.22f, 0.16f, 0.10f, 0.55f};
 constexpr float kConstrained[4] = {0.86f, 0.07f, 0.07f, 1.0f};
 
-const char* kSurfaceVs = R"(#version 120
+constexpr const char* kSurfaceVs = R"(#version 120
 attribute vec3 a_position;
 attribute vec3 a_normal;
 uniform mat4 u_mvp;
@@ -51,7 +50,7 @@ void main() {
 // colour map and lines are drawn where z crosses (k + 1/2) * u_step: half a step off the
 // round heights that level sand usually sits on, whose "contour" would only trace the
 // mesh around every disturbance. Where the surface is level within a pixel, no line.
-const char* kSurfaceFs = R"(#version 120
+constexpr const char* kSurfaceFs = R"(#version 120
 varying vec3 v_normal;
 varying float v_z;
 uniform vec3 u_light;
@@ -85,13 +84,13 @@ void main() {
 }
 )";
 
-const char* kLineVs = R"(#version 120
+constexpr const char* kLineVs = R"(#version 120
 attribute vec3 a_position;
 uniform mat4 u_mvp;
 void main() { gl_Position = u_mvp * vec4(a_position, 1.0); }
 )";
 
-const char* kLineFs = R"(#version 120
+constexpr const char* kLineFs = R"(#version 120
 uniform vec4 u_colour;
 void main() { gl_FragColor = u_colour; }
 )";
@@ -128,42 +127,6 @@ GLuint link(const char* vs, const char* fs) {
     throw std::runtime_error(std::string("renderer: shaders do not link: ") + log);
   }
   return p;
-}
-
-Mat4 look_at(const Vec3& eye, const Vec3& target, const Vec3& up) {
-  const Vec3 f = (target - eye).normalized();
-  const Vec3 s = f.cross(up).normalized();
-  const Vec3 u = s.cross(f);
-  Mat4 m = Mat4::Identity();
-  m.block<1, 3>(0, 0) = s.transpose();
-  m.block<1, 3>(1, 0) = u.transpose();
-  m.block<1, 3>(2, 0) = -f.transpose();
-  m(0, 3) = -s.dot(eye);
-  m(1, 3) = -u.dot(eye);
-  m(2, 3) = f.dot(eye);
-  return m;
-}
-
-Mat4 perspective(double fovy, double aspect, double near, double far) {
-  const double t = 1.0 / std::tan(fovy / 2.0);
-  Mat4 m = Mat4::Zero();
-  m(0, 0) = t / aspect;
-  m(1, 1) = t;
-  m(2, 2) = (far + near) / (near - far);
-  m(2, 3) = 2.0 * far * near / (near - far);
-  m(3, 2) = -1.0;
-  return m;
-}
-
-Mat4 ortho(double l, double r, double b, double t, double n, double f) {
-  Mat4 m = Mat4::Identity();
-  m(0, 0) = 2.0 / (r - l);
-  m(1, 1) = 2.0 / (t - b);
-  m(2, 2) = -2.0 / (f - n);
-  m(0, 3) = -(r + l) / (r - l);
-  m(1, 3) = -(t + b) / (t - b);
-  m(2, 3) = -(f + n) / (f - n);
-  return m;
 }
 
 // The camera for a frame, in coordinates relative to `c`. It depends on the frame alone, so
@@ -265,11 +228,6 @@ void attribute(GLuint location, const Buffer& b) {
 extern "C" const char* __lsan_default_suppressions() { return "leak:libOSMesa.so\n"; }
 
 namespace sb {
-
-Vec3 light_direction() {
-  const double az = 315.0 * kDeg, alt = 45.0 * kDeg;
-  return {std::sin(az) * std::cos(alt), std::cos(az) * std::cos(alt), std::sin(alt)};
-}
 
 struct Renderer::Gl {
   OSMesaContext context = nullptr;

@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "common/terrain.hpp"
+#include "harness/render/camera.hpp"
 #include "harness/render/frame.hpp"
 #include "harness/render/image.hpp"
 
@@ -26,12 +27,6 @@ struct RenderOptions {
   int width = 1024, height = 768;
   int supersample = 2;  // lowered when the drawn size would exceed the GL limit or 48 Mpixel
 };
-
-// The light: from the north-west, 45 degrees above the horizon (GIS hillshade convention);
-// shade = ambient + diffuse * max(0, n . light). Exposed so tests can compare with a raster.
-Vec3 light_direction();
-inline constexpr double kAmbient = 0.30;
-inline constexpr double kDiffuse = 0.75;
 
 class Renderer {
  public:

@@ -7,13 +7,32 @@
 
 namespace sb {
 
-std::vector<std::string> backend_names() { return {"tin", "grid", "sparse"}; }
+namespace {
+constexpr Backend kBackends[] = {
+    {"tin", tin::make_tin_terrain},
+    {"grid", grid::make_grid_terrain},
+    {"sparse", grid::make_sparse_terrain},
+};
+}  // namespace
+
+std::span<const Backend> backends() { return kBackends; }
+
+std::vector<std::string> backend_names() {
+  std::vector<std::string> names;
+  for (const Backend& b : kBackends) names.emplace_back(b.name);
+  return names;
+}
+
+std::string backend_list(std::string_view separator) {
+  std::string text;
+  for (const Backend& b : kBackends) text += (text.empty() ? "" : std::string(separator)) + std::string(b.name);
+  return text;
+}
 
 std::unique_ptr<Terrain> make_terrain(const std::string& backend, const Scene& scene, const HeightField& initial) {
-  if (backend == "tin") return tin::make_tin_terrain(scene, initial);
-  if (backend == "grid") return grid::make_grid_terrain(scene, initial);
-  if (backend == "sparse") return grid::make_sparse_terrain(scene, initial);
-  throw InputError("--backend " + backend + " is not a back-end; must be one of tin | grid | sparse");
+  for (const Backend& b : kBackends)
+    if (b.name == backend) return b.make(scene, initial);
+  throw InputError("--backend " + backend + " is not a back-end; must be one of " + backend_list());
 }
 
 }  // namespace sb

@@ -1,5 +1,5 @@
 #pragma once
-// The run summary: the contract metric names of DESIGN.md (flat keys such as
+// The run summary: the contract metric names of README "Summary metrics" (flat keys such as
 // "time_s.tool"), plus a few extras, computed from a RunResult.
 #include <nlohmann/json.hpp>
 

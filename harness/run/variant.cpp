@@ -26,8 +26,8 @@ Variant parse_variant(const std::string& text) {
   v.backend = text.substr(0, colon);
   const auto names = backend_names();
   if (std::find(names.begin(), names.end(), v.backend) == names.end())
-    throw InputError("--backends: \"" + v.backend +
-                     "\" is not a back-end; must be tin or grid, optionally "
+    throw InputError("--backends: \"" + v.backend + "\" is not a back-end; must be " + backend_list(" or ") +
+                     ", optionally "
                      "followed by :key=value overrides (e.g. grid:grid.storage=float)");
   if (colon == std::string::npos) return v;
   start = colon + 1;

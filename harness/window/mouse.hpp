@@ -7,7 +7,7 @@
 
 #include "common/haptics/shared_pose_device.hpp"
 #include "common/height_field.hpp"
-#include "harness/window/camera.hpp"
+#include "harness/render/camera.hpp"
 
 namespace sb {
 

@@ -1,13 +1,12 @@
 #pragma once
-// The interactive window's 3-D drawing, plain OpenGL 3.3 core: the terrain mesh (flat-shaded
+// The interactive window's 3-D drawing, plain OpenGL 3.3 core through libepoxy: the terrain mesh (flat-shaded
 // facets, coloured by height, optional wireframe) and coloured line overlays (the tool, the
 // force arrow). Uploading a mesh is O(vertices + triangles); drawing is one call per layer.
 #include <cstdint>
 #include <vector>
 
 #include "common/terrain.hpp"
-#include "harness/window/camera.hpp"
-#include "harness/window/gl.hpp"
+#include "harness/render/camera.hpp"
 
 namespace sb {
 
@@ -19,7 +18,7 @@ struct LineVertex {
 class TerrainView {
  public:
   // origin: subtracted from every position (the domain's centre); z range for the colours.
-  TerrainView(const gl::Api& api, const Vec3& origin, double z_lo, double z_hi);
+  TerrainView(const Vec3& origin, double z_lo, double z_hi);
   ~TerrainView();
   TerrainView(const TerrainView&) = delete;
   TerrainView& operator=(const TerrainView&) = delete;
@@ -31,7 +30,6 @@ class TerrainView {
   std::vector<std::uint8_t> read_pixels(int width, int height) const;
 
  private:
-  const gl::Api& gl_;
   Vec3 origin_;
   double z_lo_, z_hi_;
   unsigned surface_program_ = 0, line_program_ = 0;

@@ -169,7 +169,7 @@ TEST_F(Window, UdpBridgeDrivenByThePythonDevice) {
   const fs::path client = dir_ / "client.json", stats = dir_ / "stats.json";
   const std::string py = "/usr/bin/python3 " + std::string(SB_SOURCE_DIR) + "/experiments/udp_device.py --port " +
                          std::to_string(port) + " --scene " + scene_path() +
-                         " --duration 2.5 --wait 1.0 --extra-depth 0.002 --out " + client.string();
+                         " --duration 2.5 --wait-for-answer 60 --extra-depth 0.002 --out " + client.string();
   const std::string app = xvfb() + SB_CLI_PATH + " interactive " + scene_path() +
                           " --backend grid --device udp:" + std::to_string(port) +
                           " --frames 300 --size 640 400 --stats " + stats.string();

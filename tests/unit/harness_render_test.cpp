@@ -15,8 +15,8 @@
 #include <iterator>
 #include <string>
 
+#include "harness/figures/canvas.hpp"
 #include "harness/figures/compare_pictures.hpp"
-#include "harness/figures/font.hpp"
 #include "harness/render/colour.hpp"
 #include "harness/render/frame.hpp"
 #include "harness/render/mesh.hpp"
@@ -235,13 +235,16 @@ TEST(RenderFrame, ChangedRegionBoxesTheChangeAndSharesHeights) {
 }
 
 TEST(RenderLabels, TextAndNumbersAreDrawnAndFormatted) {
-  Image im(200, 40, {255, 255, 255});
-  draw_text(im, 2, 2, "grid 20 164 cells", {0, 0, 0}, 2);
+  Canvas canvas(200, 40, {255, 255, 255});
+  canvas.draw_text(2, 2, "grid 20 164 cells", {0, 0, 0}, 2);
+  const Image im = canvas.image();
   int ink = 0;
   for (int y = 0; y < 40; ++y)
-    for (int x = 0; x < 200; ++x) ink += im.at(x, y) == Rgb{0, 0, 0};
+    for (int x = 0; x < 200; ++x) ink += im.luminance(x, y) < 0.5;
   EXPECT_GT(ink, 100);
-  EXPECT_EQ(text_width("ab", 2), 22);
+  EXPECT_GT(text_width("abc", 2), text_width("ab", 2));
+  EXPECT_LE(text_width("grid 20 164 cells", 2), 200);
+  EXPECT_GT(text_height(2), text_height(1));
   EXPECT_EQ(format_tick(0.105, 0.005), "0.105");
   EXPECT_EQ(format_tick(-0.002, 0.001, true), "-0.002");
   EXPECT_EQ(format_tick(0.0025, 0.0025, true), "+0.0025");
