@@ -74,7 +74,7 @@ struct IntegrityReport {
 class Terrain {
  public:
   virtual ~Terrain() = default;
-  virtual std::string_view name() const = 0;  // "tin", "grid"
+  virtual std::string_view name() const = 0;  // "tin", "grid", "sparse"
   virtual double height(const Vec2& p) const = 0;
   virtual StampReport stamp(const ToolStamp& s) = 0;
   virtual ErosionReport erode(const ErosionRule& rule, const ErosionBudget& budget) = 0;

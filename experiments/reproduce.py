@@ -26,6 +26,7 @@ import exp_fig7
 import exp_fig8_9
 import exp_haptics
 import exp_memory
+import exp_sparse
 import exp_stability
 
 EXPERIMENTS = {
@@ -33,6 +34,7 @@ EXPERIMENTS = {
     "fig7": exp_fig7,
     "fig8_9": exp_fig8_9,
     "memory": exp_memory,
+    "sparse": exp_sparse,
     "drift": exp_drift,
     "alpha_flat": exp_alpha_flat,
     "accuracy": exp_accuracy,
@@ -60,7 +62,7 @@ def machine_header(ctx):
     compiler = subprocess.run(["c++", "--version"], capture_output=True, text=True).stdout.splitlines()[0]
     libs = ", ".join(f"{n} {package_version(p)}" for n, p in
                      [("CGAL", "libcgal-dev"), ("Eigen", "libeigen3-dev"), ("HDF5", "libhdf5-dev"),
-                      ("OSMesa", "libosmesa6-dev")])
+                      ("OSMesa", "libosmesa6-dev"), ("OpenVDB", "libopenvdb-dev")])
     sides = list(ctx.used.values())
     builds = sorted({s["binary"]["build_id"] for s in sides})
     commits = sorted({s["binary"]["commit"] for s in sides})

@@ -7,7 +7,7 @@
 // border axis, so volume() = sum A_k z_k is the interpolant's exact integral. Tool stamps
 // cut the footprint to the tool bottom and put exactly that volume on the rim band
 // (grid_stamp.hpp); erosion applies sb::erosion_transfers over an active set with an
-// 8- or 4-neighbour stencil (grid_erosion.hpp, active_set.hpp).
+// 8- or 4-neighbour stencil (erosion_kernel.hpp, active_set.hpp).
 //
 // Memory per node: sizeof(Real) for the height + 2 for the active-set state, i.e.
 //   double: 10 bytes/node,  float: 6 bytes/node,
@@ -36,11 +36,13 @@
 // a stamp ~80 ns per node of its window, e.g. 3 ms for a 64-cell (32 cm) disk.
 #include <functional>
 #include <memory>
+#include <optional>
 
 #include "common/height_field.hpp"
 #include "common/scene.hpp"
 #include "common/terrain.hpp"
 #include "grid/active_set.hpp"
+#include "grid/erosion_kernel.hpp"
 #include "grid/height_grid.hpp"
 #include "grid/stencil.hpp"
 
@@ -75,6 +77,7 @@ class GridTerrain final : public Terrain {
   HeightGrid<Real> grid_;
   Stencil stencil_;
   ActiveSet active_;
+  std::optional<ErosionTables> tables_;  // built on the first erode, rebuilt when the rule changes
 };
 
 extern template class GridTerrain<float>;

@@ -27,7 +27,7 @@ struct PreparedScene {
 PreparedScene prepare_scene(Scene scene);
 
 struct RunResult {
-  std::string backend;            // "tin", "grid"
+  std::string backend;            // "tin", "grid", "sparse"
   std::string label;              // backend plus variant overrides, e.g. "grid:grid.storage=float"
   std::vector<StepRecord> steps;  // stroke steps, then relaxation steps (stamp = -1)
   double volume_initial = 0.0;

@@ -35,9 +35,11 @@ const std::vector<Case>& cases() {
       {"flat_stroke-tin", "flat_stroke.toml", "tin", {}},
       {"flat_stroke-grid", "flat_stroke.toml", "grid", {}},
       {"flat_stroke-grid-float", "flat_stroke.toml", "grid", {"grid.storage=float"}},
+      {"flat_stroke-sparse", "flat_stroke.toml", "sparse", {}},
       {"pile-tin", "pile.toml", "tin", {}},
       {"pile-grid", "pile.toml", "grid", {}},
       {"pile-grid-4", "pile.toml", "grid", {"grid.neighbours=4"}},
+      {"pile-sparse", "pile.toml", "sparse", {}},
       {"dunes-tin", "dunes.toml", "tin", {}},
       {"dunes-grid", "dunes.toml", "grid", {}},
   };
