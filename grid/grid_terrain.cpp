@@ -17,7 +17,11 @@ GridTerrain<Real>::GridTerrain(const GridLayout& layout, const std::function<dou
 template <class Real>
 StampReport GridTerrain<Real>::stamp(const ToolStamp& s) {
   std::vector<std::uint32_t> changed;
-  const StampReport report = stamp_grid(grid_, s, changed);
+  const double carry_before = grid_.carry_m3();
+  StampReport report = stamp_grid(grid_, s, changed);
+  // What the stored volume changed by: the stamp's own sums, less what rounding put into
+  // the carry (zero in double).
+  report.volume_change_m3 = report.volume_deposited_m3 - report.volume_removed_m3 - (grid_.carry_m3() - carry_before);
   const GridLayout& layout = grid_.layout();
   for (std::uint32_t k : changed) {
     const auto [ix, iy] = layout.split(k);
@@ -30,7 +34,11 @@ template <class Real>
 ErosionReport GridTerrain<Real>::erode(const ErosionRule& rule, const ErosionBudget& budget) {
   const bool gradient = false;
   if (!tables_ || !tables_->built_for(rule, gradient)) tables_.emplace(grid_.layout(), stencil_.size, rule, gradient);
-  return erode_ordered(grid_, active_, *tables_, budget);
+  const double carry_before = grid_.carry_m3();
+  ErosionReport report = erode_ordered(grid_, active_, *tables_, budget);
+  // Transfers conserve volume; only rounding into the carry changes the stored volume.
+  report.volume_change_m3 = carry_before - grid_.carry_m3();
+  return report;
 }
 
 template <class Real>
@@ -45,6 +53,33 @@ ModelStats GridTerrain<Real>::stats() const {
 template <class Real>
 SurfaceMesh GridTerrain<Real>::mesh() const {
   return grid_mesh(grid_);
+}
+
+template <class Real>
+void GridTerrain<Real>::stream_mesh(MeshSink& sink) const {
+  // The same mesh as mesh(), a row of nodes (and the triangles of a row of cells) at a time.
+  const GridLayout& layout = grid_.layout();
+  sink.begin(layout.nodes(), 2 * (layout.nx - 1) * (layout.ny - 1), 0);
+  std::vector<Vec3> row(layout.nx);
+  for (std::size_t iy = 0; iy < layout.ny; ++iy) {
+    for (std::size_t ix = 0; ix < layout.nx; ++ix) {
+      const Vec2 p = layout.position(ix, iy);
+      row[ix] = Vec3(p.x(), p.y(), grid_.z(ix, iy));
+    }
+    sink.vertices(row);
+  }
+  row = {};
+  std::vector<std::array<std::uint32_t, 3>> cells(2 * (layout.nx - 1));
+  for (std::size_t iy = 0; iy + 1 < layout.ny; ++iy) {
+    for (std::size_t ix = 0; ix + 1 < layout.nx; ++ix) {
+      const std::uint32_t a = layout.index(ix, iy), b = a + 1;
+      const std::uint32_t c = layout.index(ix, iy + 1), d = c + 1;
+      cells[2 * ix] = {a, b, d};  // as in mesh()
+      cells[2 * ix + 1] = {a, d, c};
+    }
+    sink.triangles(cells);
+  }
+  sink.constrained_edges({});
 }
 
 template <class Real>

@@ -63,6 +63,7 @@ class GridTerrain final : public Terrain {
   double volume() const override { return grid_.volume(); }
   ModelStats stats() const override;
   SurfaceMesh mesh() const override;
+  void stream_mesh(MeshSink& sink) const override;  // O(n) time, O(nx) memory
   void sample(Raster& out) const override;
   IntegrityReport check() const override;
   double max_slope_deg() const override;

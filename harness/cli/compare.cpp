@@ -109,8 +109,12 @@ void compare_command(const CompareOptions& o) {
     write_text_atomically(dir / "summary.json", report.dump(2) + "\n");
     write_text_atomically(dir / "table.md", table);
     std::vector<PictureRun> pictures;
-    for (const auto& r : runs)
-      pictures.push_back({r.run.label, &r.run.final_mesh, &r.run.initial_raster, &r.run.final_raster, &r.summary});
+    std::vector<SurfaceMesh> meshes;
+    meshes.reserve(runs.size());
+    for (const auto& r : runs) {
+      meshes.push_back(r.run.final_surface());
+      pictures.push_back({r.run.label, &meshes.back(), &r.run.initial_raster, &r.run.final_raster, &r.summary});
+    }
     write_compare_pictures(dir, pictures);
     std::cerr << "wrote " << dir.string() << "/{*.h5,summary.json,table.md,side_by_side.png"
               << (runs.size() > 1 ? ",difference.png}\n" : "}\n");
