@@ -1,4 +1,4 @@
-// `sandbench compare SCENE [--backends tin,grid] [--out DIR] [--json] [--set k=v ...]`:
+// `sandbench compare SCENE [--backends tin,grid,sparse] [--out DIR] [--json] [--set k=v ...]`:
 // the same schedule on each back-end (or back-end variant), a table, the summaries and pictures.
 #include <fstream>
 #include <iomanip>
@@ -78,7 +78,7 @@ std::string markdown_table(const std::vector<VariantRun>& runs) {
 void compare_command(const CompareOptions& o) {
   PreparedScene prepared = prepare_scene(load_scene(o.scene, o.overrides));
   std::vector<Variant> variants;
-  for (const auto& item : split(o.backends.empty() ? "tin,grid" : o.backends, ','))
+  for (const auto& item : split(o.backends.empty() ? "tin,grid,sparse" : o.backends, ','))
     variants.push_back(parse_variant(item));
   if (variants.empty()) throw InputError("--backends is empty; give e.g. tin,grid");
   const std::filesystem::path dir = o.out;
@@ -109,8 +109,12 @@ void compare_command(const CompareOptions& o) {
     write_text_atomically(dir / "summary.json", report.dump(2) + "\n");
     write_text_atomically(dir / "table.md", table);
     std::vector<PictureRun> pictures;
-    for (const auto& r : runs)
-      pictures.push_back({r.run.label, &r.run.final_mesh, &r.run.initial_raster, &r.run.final_raster, &r.summary});
+    std::vector<SurfaceMesh> meshes;
+    meshes.reserve(runs.size());
+    for (const auto& r : runs) {
+      meshes.push_back(r.run.final_surface());
+      pictures.push_back({r.run.label, &meshes.back(), &r.run.initial_raster, &r.run.final_raster, &r.summary});
+    }
     write_compare_pictures(dir, pictures);
     std::cerr << "wrote " << dir.string() << "/{*.h5,summary.json,table.md,side_by_side.png"
               << (runs.size() > 1 ? ",difference.png}\n" : "}\n");
@@ -128,7 +132,7 @@ void add_compare_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("compare", "Run the same schedule on several back-ends and compare them");
   cmd->add_option("scene", opts->scene, "Scene file (TOML)")->required();
   cmd->add_option("--backends", opts->backends,
-                  "Comma-separated back-ends or variants (default tin,grid), e.g. grid,grid:grid.storage=float");
+                  "Comma-separated back-ends or variants (default tin,grid,sparse), e.g. grid,grid:grid.storage=float");
   cmd->add_option("--out", opts->out,
                   "Directory for run files, summary.json, table.md, side_by_side.png and difference.png");
   cmd->add_flag("--json", opts->json, "Print the report as JSON on stdout");

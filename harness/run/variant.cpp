@@ -59,6 +59,7 @@ VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_pr
   VariantRun out{
       run_schedule(*terrain, prepared, show_progress ? terminal_progress(v.label) : ProgressFn{}), prepared, {}};
   out.run.label = v.label;
+  out.run.final_terrain = std::move(terrain);
   out.summary = summarize(out.run, prepared);
   return out;
 }

@@ -30,6 +30,10 @@ struct Grid {
   static constexpr const char* kName = "grid";
   static std::vector<std::string> overrides() { return {}; }
 };
+struct Sparse {
+  static constexpr const char* kName = "sparse";
+  static std::vector<std::string> overrides() { return {}; }
+};
 
 // A 0.04 m square plane tilted at `slope_deg` toward `azimuth_deg`, disturbed by a grain
 // poured at its centre (the avalanche spreads from there).
@@ -109,7 +113,7 @@ struct BackendName {
     return T::kName;
   }
 };
-using Backends = ::testing::Types<Tin, Grid>;
+using Backends = ::testing::Types<Tin, Grid, Sparse>;
 TYPED_TEST_SUITE(ReposeTyped, Backends, BackendName);
 
 TYPED_TEST(ReposeTyped, PlaneSteeperThanCriticalRelaxesToItInEveryAzimuth) {

@@ -19,7 +19,7 @@ namespace sb {
 namespace {
 
 // The TIN compensates retriangulation volume changes only when asked (tin.conserve_volume);
-// the grid's bookkeeping is exact by construction.
+// the grids' bookkeeping is exact by construction.
 struct Tin {
   static constexpr const char* kName = "tin";
   static std::vector<std::string> overrides() { return {"tin.conserve_volume=true"}; }
@@ -27,6 +27,11 @@ struct Tin {
 };
 struct Grid {
   static constexpr const char* kName = "grid";
+  static std::vector<std::string> overrides() { return {}; }
+  static constexpr double kVolumeTolerance = 1e-12;
+};
+struct Sparse {
+  static constexpr const char* kName = "sparse";
   static std::vector<std::string> overrides() { return {}; }
   static constexpr double kVolumeTolerance = 1e-12;
 };
@@ -136,7 +141,7 @@ struct BackendName {
     return T::kName;
   }
 };
-using Backends = ::testing::Types<Tin, Grid>;
+using Backends = ::testing::Types<Tin, Grid, Sparse>;
 TYPED_TEST_SUITE(TerrainTyped, Backends, BackendName);
 
 TYPED_TEST(TerrainTyped, VolumeIsKeptByEveryPhase) {
