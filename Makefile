@@ -30,9 +30,18 @@ test: build
 test-asan:
 	@$(MAKE) --no-print-directory test PRESET=asan-ubsan
 
+# ENGINE=local (a pool of JOBS runs on this machine) or ENGINE=slurm (one job array through
+# sbatch; SLURM_PARTITION, SLURM_ACCOUNT, SLURM_TIME and SLURM_MEM per array task, at most
+# SLURM_PARALLEL tasks at once, SLURM_BATCH runs per task, SLURM_ARGS passed to sbatch as is).
+ENGINE ?= local
+SLURM_PARALLEL ?= 32
+SLURM_BATCH ?= 1
 reproduce: build
 	@$(PYTHON) experiments/reproduce.py --sandbench $(BUILD_DIR)/harness/sandbench --results results \
-		$(if $(filter 1,$(FULL)),--full,)
+		$(if $(filter 1,$(FULL)),--full,) --engine $(ENGINE) --jobs $(JOBS) \
+		$(if $(SLURM_PARTITION),--partition $(SLURM_PARTITION),) $(if $(SLURM_ACCOUNT),--account $(SLURM_ACCOUNT),) \
+		$(if $(SLURM_TIME),--time $(SLURM_TIME),) $(if $(SLURM_MEM),--mem $(SLURM_MEM),) \
+		--parallel $(SLURM_PARALLEL) --batch $(SLURM_BATCH) $(foreach a,$(SLURM_ARGS),--sbatch-arg=$(a))
 
 bench: build
 	@for b in $(BUILD_DIR)/tests/*_bench; do \

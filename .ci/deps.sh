@@ -11,6 +11,8 @@ packages=(
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
   python3-numpy python3-matplotlib python3-h5py
   libglfw3-dev libimgui-dev xvfb xauth
+  munge slurmctld slurmd slurm-client  # the slurm test's own cluster (it starts and stops the daemons)
+  libopenvdb-dev libtbb-dev
   libcairo2-dev fonts-dejavu-core libepoxy-dev
   clang-format
 )

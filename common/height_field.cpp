@@ -44,6 +44,9 @@ HeightField HeightField::from_scene(const Scene& scene) {
       shortest = std::min(shortest, wavelength);
     }
     f.feature_m_ = shortest / 8.0;
+  } else if (f.kind_ == TerrainKind::Plane) {
+    const double a = deg_to_rad(scene.terrain.azimuth_deg);
+    f.plane_gradient_ = -std::tan(deg_to_rad(scene.terrain.slope_deg)) * Vec2(std::cos(a), std::sin(a));
   } else if (f.kind_ == TerrainKind::Heightmap) {
     const Png16 png = read_png16(scene.terrain.heightmap_path, "terrain.path");
     f.img_w_ = png.width;
@@ -64,6 +67,8 @@ double HeightField::operator()(const Vec2& p) const {
   switch (kind_) {
     case TerrainKind::Flat:
       return base_m_;
+    case TerrainKind::Plane:
+      return base_m_ + plane_gradient_.dot(p - (domain_.origin_m + 0.5 * domain_.size_m));
     case TerrainKind::Dunes: {
       double sum = 0.0;
       for (const Ridge& r : ridges_) {

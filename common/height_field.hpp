@@ -1,6 +1,6 @@
 #pragma once
 // HeightField: the scene's initial surface as a function z(x, y) over the domain -- flat,
-// seeded procedural dunes, or a 16-bit PNG heightmap stretched over the domain. Back-ends
+// a tilted plane, seeded procedural dunes, or a 16-bit PNG heightmap stretched over the domain. Back-ends
 // build their models from it; schedules use it for the tool depth. Evaluation is O(1).
 #include <cstdint>
 #include <vector>
@@ -30,6 +30,7 @@ class HeightField {
   TerrainKind kind_ = TerrainKind::Flat;
   double base_m_ = 0.0;
   double amplitude_m_ = 0.0;
+  Vec2 plane_gradient_{0.0, 0.0};  // plane: dz/dx, dz/dy
   std::vector<Ridge> ridges_;
   double ridge_weight_sum_ = 1.0;
   std::size_t img_w_ = 0, img_h_ = 0;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
 #include <vector>
 
 namespace sb {
@@ -90,6 +91,8 @@ std::optional<Raster> reference_raster(const Scene& scene, const StampSchedule& 
     case ReferenceKind::Crater:
       return crater_reference(first, initial, lattice);
     case ReferenceKind::Trench:
+    case ReferenceKind::Ridge:
+    case ReferenceKind::Plane:
     case ReferenceKind::None:
       return std::nullopt;
   }
@@ -164,7 +167,60 @@ TrenchShape measure_trench(const Raster& h, const Raster& initial, const Vec2& a
     }
   }
   shape.depth_m = median(depths);
-  shape.wall_angle_deg = angles.empty() ? 0.0 : *std::max_element(angles.begin(), angles.end());
+  shape.sections = static_cast<int>(angles.size());
+  if (angles.empty()) return shape;
+  double sum = 0.0, sq = 0.0;
+  for (double v : angles) sum += v;
+  shape.wall_angle_mean_deg = sum / static_cast<double>(angles.size());
+  for (double v : angles) sq += (v - shape.wall_angle_mean_deg) * (v - shape.wall_angle_mean_deg);
+  shape.wall_angle_spread_deg = std::sqrt(sq / static_cast<double>(angles.size()));
+  shape.wall_angle_deg = *std::max_element(angles.begin(), angles.end());
+  shape.wall_angle_min_deg = *std::min_element(angles.begin(), angles.end());
+  return shape;
+}
+
+TrenchShape measure_ridge(const Raster& h, const Raster& initial, const Vec2& a, const Vec2& b) {
+  Raster flipped = h, flipped_initial = initial;
+  for (double& v : flipped.values) v = -v;
+  for (double& v : flipped_initial.values) v = -v;
+  return measure_trench(flipped, flipped_initial, a, b);
+}
+
+PlaneShape measure_plane(const Raster& h) {
+  // Least squares z = c + gx (x - mx) + gy (y - my) over the raster points in the middle half
+  // of each axis (centred coordinates decouple c from the slopes).
+  std::vector<Vec2> p;
+  std::vector<double> z;
+  for (std::size_t iy = h.ny / 4; iy < h.ny - h.ny / 4; ++iy)
+    for (std::size_t ix = h.nx / 4; ix < h.nx - h.nx / 4; ++ix) {
+      p.push_back(h.point(ix, iy));
+      z.push_back(h.at(ix, iy));
+    }
+  PlaneShape shape;
+  if (p.size() < 3) return shape;
+  const auto n = static_cast<double>(p.size());
+  Vec2 m(0.0, 0.0);
+  double mz = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) m += p[i], mz += z[i];
+  m /= n;
+  mz /= n;
+  double sxx = 0, sxy = 0, syy = 0, sxz = 0, syz = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Vec2 d = p[i] - m;
+    sxx += d.x() * d.x(), sxy += d.x() * d.y(), syy += d.y() * d.y();
+    sxz += d.x() * (z[i] - mz), syz += d.y() * (z[i] - mz);
+  }
+  const double det = sxx * syy - sxy * sxy;
+  if (!(det > 0.0)) return shape;
+  const double gx = (sxz * syy - syz * sxy) / det, gy = (syz * sxx - sxz * sxy) / det;
+  shape.slope_deg = rad_to_deg(std::atan(std::hypot(gx, gy)));
+  shape.azimuth_deg = rad_to_deg(std::atan2(-gy, -gx));
+  double sq = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double r = z[i] - (mz + gx * (p[i].x() - m.x()) + gy * (p[i].y() - m.y()));
+    sq += r * r;
+  }
+  shape.rms_m = std::sqrt(sq / n);
   return shape;
 }
 
@@ -191,12 +247,28 @@ nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule&
     j["pile.radius_expected_m"] = cone_radius(volume, scene.material.tan_critical());
     j["pile.height_m"] = p.height_m;
   }
-  if (scene.reference == ReferenceKind::Trench) {
+  if (scene.reference == ReferenceKind::Trench || scene.reference == ReferenceKind::Ridge) {
     const auto& path = scene.stroke.path_m;
-    const TrenchShape t = measure_trench(final_raster, initial_raster, path.front(), path.back());
-    j["trench.wall_angle_deg"] = t.wall_angle_deg;
-    j["trench.wall_excess_deg"] = std::max(0.0, t.wall_angle_deg - crit);
-    j["trench.depth_m"] = t.depth_m;
+    const bool trench = scene.reference == ReferenceKind::Trench;
+    const TrenchShape t = trench ? measure_trench(final_raster, initial_raster, path.front(), path.back())
+                                 : measure_ridge(final_raster, initial_raster, path.front(), path.back());
+    const std::string key = trench ? "trench.wall_" : "ridge.flank_";
+    j[key + "angle_deg"] = t.wall_angle_deg;  // the steepest section
+    j[key + "angle_mean_deg"] = t.wall_angle_mean_deg;
+    j[key + "angle_min_deg"] = t.wall_angle_min_deg;
+    j[key + "angle_spread_deg"] = t.wall_angle_spread_deg;
+    j[key + "excess_deg"] = std::max(0.0, t.wall_angle_deg - crit);
+    j[key + "mean_error_deg"] = t.wall_angle_mean_deg - crit;
+    j[key + "worst_error_deg"] = t.worst_error_deg(crit);
+    j[key + "sections"] = t.sections;
+    j[trench ? "trench.depth_m" : "ridge.height_m"] = t.depth_m;
+  }
+  if (scene.reference == ReferenceKind::Plane) {
+    const PlaneShape p = measure_plane(final_raster);
+    j["plane.slope_deg"] = p.slope_deg;
+    j["plane.slope_error_deg"] = p.slope_deg - crit;
+    j["plane.azimuth_deg"] = p.azimuth_deg;
+    j["plane.rms_m"] = p.rms_m;
   }
   return j;
 }

@@ -21,6 +21,8 @@ std::string to_string(TerrainKind k) {
       return "dunes";
     case TerrainKind::Heightmap:
       return "heightmap";
+    case TerrainKind::Plane:
+      return "plane";
   }
   return "?";
 }
@@ -35,6 +37,10 @@ std::string to_string(ReferenceKind k) {
       return "crater";
     case ReferenceKind::Trench:
       return "trench";
+    case ReferenceKind::Ridge:
+      return "ridge";
+    case ReferenceKind::Plane:
+      return "plane";
   }
   return "?";
 }
@@ -304,14 +310,21 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   const double extent = std::max(s.domain.size_m.x(), s.domain.size_m.y());
 
   // [terrain]
-  const std::string kind = f.choice("terrain.kind", "flat", {"flat", "dunes", "heightmap"});
-  s.terrain.kind = kind == "flat" ? TerrainKind::Flat : kind == "dunes" ? TerrainKind::Dunes : TerrainKind::Heightmap;
+  const std::string kind = f.choice("terrain.kind", "flat", {"flat", "dunes", "heightmap", "plane"});
+  s.terrain.kind = kind == "flat"        ? TerrainKind::Flat
+                   : kind == "dunes"     ? TerrainKind::Dunes
+                   : kind == "heightmap" ? TerrainKind::Heightmap
+                                         : TerrainKind::Plane;
   s.terrain.height_m = f.number("terrain.height_m", 0.1, open(-1e6, 1e6));
   if (s.terrain.kind == TerrainKind::Dunes) {
     s.terrain.dune_amplitude_m = f.number("terrain.amplitude_m", 0.02, closed(0.0, 1e3));
     s.terrain.dune_wavelength_m = f.number("terrain.wavelength_m", 0.2, positive(1e6));
     s.terrain.dune_components = static_cast<int>(f.integer("terrain.components", 4, 1, 64));
     s.terrain.seed = f.integer("terrain.seed", 1, 0, std::numeric_limits<long long>::max());
+  }
+  if (s.terrain.kind == TerrainKind::Plane) {
+    s.terrain.slope_deg = f.number("terrain.slope_deg", 0.0, closed(0.0, 89.0));
+    s.terrain.azimuth_deg = f.number("terrain.azimuth_deg", 0.0, closed(-360.0, 360.0));
   }
   if (s.terrain.kind == TerrainKind::Heightmap) {
     std::filesystem::path p = f.string("terrain.path", /*required=*/true);
@@ -332,6 +345,8 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   s.erosion.settle_tolerance_deg = f.number("erosion.settle_tolerance_deg", 0.1, closed(0.0, 10.0));
   s.erosion.relax_at_end = f.boolean("erosion.relax_at_end", true);
   s.erosion.relax_max_passes = static_cast<int>(f.integer("erosion.relax_max_passes", 20000, 0, 100000000));
+  s.erosion.rule = f.choice("erosion.rule", "edge", {"gradient", "edge"}) == "gradient" ? ErosionRuleKind::Gradient
+                                                                                        : ErosionRuleKind::Edge;
 
   // [tool]
   const std::string shape = f.choice("tool.shape", "disk", {"disk", "box", "ellipse", "polygon", "pour"});
@@ -428,15 +443,22 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
     Fields::fail("grid.neighbours", "= " + std::to_string(s.grid.neighbours) + " is not allowed; must be 4 or 8");
 
   // [reference]
-  const std::string reference = f.choice("reference.kind", "none", {"none", "pile", "crater", "trench"});
+  const std::string reference =
+      f.choice("reference.kind", "none", {"none", "pile", "crater", "trench", "ridge", "plane"});
   s.reference = reference == "pile"     ? ReferenceKind::Pile
                 : reference == "crater" ? ReferenceKind::Crater
                 : reference == "trench" ? ReferenceKind::Trench
+                : reference == "ridge"  ? ReferenceKind::Ridge
+                : reference == "plane"  ? ReferenceKind::Plane
                                         : ReferenceKind::None;
   if (s.reference == ReferenceKind::Pile && t.shape != ToolShape::Pour)
     Fields::fail("reference.kind", "= \"pile\" needs tool.shape = \"pour\"");
   if (s.reference == ReferenceKind::Trench && s.stroke.path_m.size() != 2)
     Fields::fail("reference.kind", "= \"trench\" needs a straight stroke.path_m of 2 points");
+  if (s.reference == ReferenceKind::Ridge && (t.shape != ToolShape::Pour || s.stroke.path_m.size() != 2))
+    Fields::fail("reference.kind", "= \"ridge\" needs tool.shape = \"pour\" and a straight stroke.path_m of 2 points");
+  if (s.reference == ReferenceKind::Plane && s.terrain.kind != TerrainKind::Plane)
+    Fields::fail("reference.kind", "= \"plane\" needs terrain.kind = \"plane\"");
 
   // [output]
   s.output.raster_m = f.number("output.raster_m", std::min(0.0025, extent / 100.0), positive(extent));

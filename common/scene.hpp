@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "common/erosion.hpp"
 #include "common/geometry.hpp"
 #include "common/haptics/rendering.hpp"
 #include "common/material.hpp"
@@ -14,7 +15,7 @@
 
 namespace sb {
 
-enum class TerrainKind { Flat, Dunes, Heightmap };
+enum class TerrainKind { Flat, Dunes, Heightmap, Plane };
 std::string to_string(TerrainKind k);
 
 struct DomainSpec {
@@ -34,6 +35,10 @@ struct TerrainSpec {
   // heightmap: 16-bit grey PNG stretched over the domain; z = height_m + v/65535 * scale
   std::filesystem::path heightmap_path;
   double vertical_scale_m = 0.1;
+  // plane: height_m at the domain's centre, falling at slope_deg toward azimuth_deg
+  // (counter-clockwise from +x); for the angle-of-repose experiments.
+  double slope_deg = 0.0;
+  double azimuth_deg = 0.0;
 };
 
 struct ErosionSpec {
@@ -42,6 +47,10 @@ struct ErosionSpec {
   double settle_tolerance_deg = 0.1;  // slopes up to critical + this count as stable
   bool relax_at_end = true;           // after the stroke, erode until settled
   int relax_max_passes = 20000;
+  // "edge" (the paper's rule: neighbour directions only; the default until the TIN passes
+  // its tests with the other) or "gradient" (at rest at the critical angle in every
+  // azimuth); see common/erosion.hpp.
+  ErosionRuleKind rule = ErosionRuleKind::Edge;
 };
 
 struct TinSpec {
@@ -73,7 +82,7 @@ struct GridSpec {
 };
 
 // The analytic shape the run is measured against (common/reference.hpp).
-enum class ReferenceKind { None, Pile, Crater, Trench };
+enum class ReferenceKind { None, Pile, Crater, Trench, Ridge, Plane };
 std::string to_string(ReferenceKind k);
 
 struct OutputSpec {

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -17,10 +18,16 @@
 
 namespace sb {
 
+// Volume changes a back-end reports for one phase (volume_change_m3): exact bookkeeping of
+// its own writes, so the runner need not integrate the surface after every phase. NaN means
+// "not tracked": the runner measures volume() instead.
+inline constexpr double kVolumeChangeUnknown = std::numeric_limits<double>::quiet_NaN();
+
 struct StampReport {
-  double volume_removed_m3 = 0.0;    // cut out of the footprint
-  double volume_deposited_m3 = 0.0;  // put on the rim (equals removed) or poured
-  std::size_t elements_touched = 0;  // cells or triangles the tool touched
+  double volume_change_m3 = kVolumeChangeUnknown;  // volume() after minus before
+  double volume_removed_m3 = 0.0;                  // cut out of the footprint
+  double volume_deposited_m3 = 0.0;                // put on the rim (equals removed) or poured
+  std::size_t elements_touched = 0;                // cells or triangles the tool touched
   std::size_t vertices_inserted = 0;
   std::size_t vertices_removed = 0;
 };
@@ -31,6 +38,7 @@ struct ErosionBudget {
 };
 
 struct ErosionReport {
+  double volume_change_m3 = kVolumeChangeUnknown;  // volume() after minus before (rounding only)
   int passes = 0;
   std::size_t updates = 0;    // element visits (an element and its neighbours examined)
   std::size_t transfers = 0;  // neighbour transfers made
@@ -43,7 +51,8 @@ struct SimplifyParams {
 };
 
 struct SimplifyReport {
-  std::size_t candidates = 0;  // vertices examined (the paper's L_r)
+  double volume_change_m3 = kVolumeChangeUnknown;  // volume() after minus before
+  std::size_t candidates = 0;                      // vertices examined (the paper's L_r)
   std::size_t removed = 0;
   double detect_s = 0.0;  // redundant-vertex detection time
   double remove_s = 0.0;  // vertex removal time
@@ -66,6 +75,25 @@ struct SurfaceMesh {
   std::vector<std::array<std::uint32_t, 2>> constrained_edges;
 };
 
+// Receives a surface mesh piece by piece (Terrain::stream_mesh): the counts first, then the
+// vertices in order, then the triangles, then the constrained edges, each in one or more calls.
+class MeshSink {
+ public:
+  virtual ~MeshSink() = default;
+  virtual void begin(std::size_t vertices, std::size_t triangles, std::size_t constrained_edges) = 0;
+  virtual void vertices(std::span<const Vec3> v) = 0;
+  virtual void triangles(std::span<const std::array<std::uint32_t, 3>> t) = 0;
+  virtual void constrained_edges(std::span<const std::array<std::uint32_t, 2>> e) = 0;
+};
+
+// Hands a whole mesh to a sink in one piece each.
+inline void stream_mesh(const SurfaceMesh& m, MeshSink& sink) {
+  sink.begin(m.vertices.size(), m.triangles.size(), m.constrained_edges.size());
+  sink.vertices(m.vertices);
+  sink.triangles(m.triangles);
+  sink.constrained_edges(m.constrained_edges);
+}
+
 struct IntegrityReport {
   std::vector<std::string> problems;
   bool ok() const { return problems.empty(); }
@@ -74,7 +102,7 @@ struct IntegrityReport {
 class Terrain {
  public:
   virtual ~Terrain() = default;
-  virtual std::string_view name() const = 0;  // "tin", "grid"
+  virtual std::string_view name() const = 0;  // "tin", "grid", "sparse"
   virtual double height(const Vec2& p) const = 0;
   virtual StampReport stamp(const ToolStamp& s) = 0;
   virtual ErosionReport erode(const ErosionRule& rule, const ErosionBudget& budget) = 0;
@@ -82,6 +110,9 @@ class Terrain {
   virtual double volume() const = 0;  // exact integral of the surface above z = 0
   virtual ModelStats stats() const = 0;
   virtual SurfaceMesh mesh() const = 0;
+  // mesh(), piece by piece, for writers that must not hold a copy of a large model. The
+  // default builds mesh() and hands it over whole.
+  virtual void stream_mesh(MeshSink& sink) const { sb::stream_mesh(mesh(), sink); }
   virtual void sample(Raster& out) const = 0;  // heights at every raster point
   virtual IntegrityReport check() const = 0;
   // Steepest slope between neighbours (the graph erosion uses), in degrees. O(model).

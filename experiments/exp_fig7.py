@@ -17,14 +17,17 @@ def run(ctx):
     for n in ns:
         jobs.append((sbrun.DIAGONAL_SCENE, "tin", f"fig7/tin-N{n}", common + [f"tin.initial_points={n}"]))
         jobs.append((sbrun.DIAGONAL_SCENE, "grid", f"fig7/grid-N{n}", common + [f"grid.cell_m={sbrun.grid_cell_for(n):.8f}"]))
+        jobs.append((sbrun.DIAGONAL_SCENE, "sparse", f"fig7/sparse-N{n}",
+                     common + [f"grid.cell_m={sbrun.grid_cell_for(n):.8f}"]))
     s = ctx.run_many("fig7", jobs)
-    tin, grid = s[0::2], s[1::2]
+    tin, grid, sparse = s[0::3], s[1::3], s[2::3]
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     for key, name in PARTS:
         ax.plot(ns, [r[key] for r in tin], marker="o", label=f"TIN {name}")
     ax.plot(ns, [r["time_s.total"] for r in tin], marker="s", color="k", label="TIN total")
     ax.plot(ns, [r["time_s.total"] for r in grid], marker="^", color="grey", ls="--", label="grid total (same cells)")
+    ax.plot(ns, [r["time_s.total"] for r in sparse], marker="v", color="C2", ls=":", label="sparse grid total (same cells)")
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("model size N (TIN vertices / grid nodes)")
@@ -40,6 +43,8 @@ def run(ctx):
     slopes = {name: sbrun.loglog_slope(ns, [r[key] for r in tin]) for key, name in PARTS}
     slopes["total"] = sbrun.loglog_slope(ns, [r["time_s.total"] for r in tin])
     grid_slope = sbrun.loglog_slope(ns, [r["time_s.total"] for r in grid])
+    sparse_slope = sbrun.loglog_slope(ns, [r["time_s.total"] for r in sparse])
+    sparse_ratio = sorted(sp["time_s.total"] / max(g["time_s.total"], 1e-30) for sp, g in zip(sparse, grid))
     rows.append(["exponent", "", slopes["tool"], slopes["erosion"], slopes["detection"], slopes["removal"],
                  slopes["total"], "", grid_slope])
     md = ctx.table("fig7_time_vs_size", ["N", "TIN vertices after", "tool s", "erosion s", "detection s",
@@ -69,6 +74,8 @@ vertices of L_r flatter than alpha_flat).
 - The grid at the same number of nodes: exponent {grid_slope:.2f} for its total. A grid of more nodes has
   smaller cells, so the same tool covers more of them: its cost follows the nodes under the tool and in the
   erosion's active set (about N^1 for a fixed tool), never the whole grid.
+- The sparse grid (OpenVDB, same cells, same heights): exponent {sparse_slope:.2f} for its total,
+  {sparse_ratio[len(sparse_ratio) // 2]:.2f}x the dense grid's time (median over the sizes).
 """
     return text
 

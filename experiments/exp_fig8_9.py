@@ -16,8 +16,10 @@ def run(ctx):
         common = [sbrun.diagonal_path(f), "erosion.relax_at_end=false"]
         jobs.append((sbrun.DIAGONAL_SCENE, "tin", f"fig8/tin-L{f:.2f}", common + [f"tin.initial_points={n}"]))
         jobs.append((sbrun.DIAGONAL_SCENE, "grid", f"fig8/grid-L{f:.2f}", common + [f"grid.cell_m={sbrun.grid_cell_for(n):.8f}"]))
+        jobs.append((sbrun.DIAGONAL_SCENE, "sparse", f"fig8/sparse-L{f:.2f}",
+                     common + [f"grid.cell_m={sbrun.grid_cell_for(n):.8f}"]))
     s = ctx.run_many("fig8/9", jobs)
-    tin, grid = s[0::2], s[1::2]
+    tin, grid, sparse = s[0::3], s[1::3], s[2::3]
     lengths = [sbrun.trace_length(f) for f in fractions]
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
@@ -25,6 +27,7 @@ def run(ctx):
         ax.plot(lengths, [r[key] for r in tin], marker="o", label=f"TIN {name}")
     ax.plot(lengths, [r["time_s.total"] for r in tin], marker="s", color="k", label="TIN total")
     ax.plot(lengths, [r["time_s.total"] for r in grid], marker="^", color="grey", ls="--", label="grid total")
+    ax.plot(lengths, [r["time_s.total"] for r in sparse], marker="v", color="C2", ls=":", label="sparse grid total")
     ax.set_xlabel("trace length [fraction of the diagonal]")
     ax.set_ylabel("time over the whole stroke [s]")
     ax.set_title(f"Fig. 8: time per part vs trace length (N = {n})")
@@ -69,7 +72,8 @@ def run(ctx):
   {sl['erosion']:.2f}).
 - *Paper: vertex removal grows faster than linearly in trace length.* Ours: exponent {sl['removal']:.2f} for
   removal ({'reproduced' if sl['removal'] > 1.15 else 'not reproduced: linear, since each stamp removes a bounded number of vertices near the tool'}),
-  {sl_total:.2f} for the TIN's total, {sl_grid:.2f} for the grid's.
+  {sl_total:.2f} for the TIN's total, {sl_grid:.2f} for the grid's,
+  {sbrun.loglog_slope(lengths, [r["time_s.total"] for r in sparse]):.2f} for the sparse grid's.
 
 ## Figure 9: elements against trace length
 

@@ -132,10 +132,14 @@ def run(ctx):
     if shutil.which("xvfb-run") is None:
         return "## Haptic forces on a replayed stroke\n\nSkipped: xvfb-run is not installed (`make deps`).\n"
     workdir = ctx.runs / "haptics"
+    # Real-time replays run on this machine whatever the engine; reused only from this binary.
+    what = ["haptics replay", RECORDING, SCENE, *BACKENDS]
+    current = ctx.is_current(workdir, what)
     runs = {}
     for b in BACKENDS:
         sbrun.progress(f"  haptics: replaying {RECORDING.name} on {b}")
-        runs[b] = replay(ctx.sandbench, b, workdir, reuse=True)
+        runs[b] = replay(ctx.sandbench, b, workdir, reuse=current)
+    ctx.mark_current(workdir, what)
 
     with open(SCENE, "rb") as f:
         stiffness = min(float(tomllib.load(f).get("material", {}).get("stiffness_n_per_m", 800.0)), 2000.0)

@@ -2,11 +2,9 @@
 """Stability matrix: every case on every back-end ends as ok, degraded (which metric and how
 much), refused (the message) or crashed (never acceptable). A case is a scene plus --set
 overrides, or a scene file with a bad value; each run has a time limit."""
-import json
-import math
-import subprocess
-import tempfile
+import re
 from pathlib import Path
+from types import SimpleNamespace
 
 import sbrun
 
@@ -47,8 +45,9 @@ CASES = {
 }
 
 
-def scene_with(text_marker, tmp):
-    """The base scene with one bad value written into the file (not through --set)."""
+def scene_with(text_marker, folder):
+    """The base scene with one bad value written into the file (not through --set), kept with
+    the runs (a cluster's nodes must read it)."""
     text = BASE.read_text()
     if text_marker == "EMPTY_PATH":
         text = text.replace("path_m = [[0.31820, 0.31820], [0.38891, 0.38891]]", "path_m = []")
@@ -56,8 +55,9 @@ def scene_with(text_marker, tmp):
         text = text.replace("size_m = [0.70710678, 0.70710678]", "size_m = [-0.7, 0.7]")
     else:
         text = text.replace("radius_m = 0.02", text_marker)
-    path = Path(tmp) / "bad.toml"
-    path.write_text(text)
+    path = Path(folder) / f"bad-{re.sub(r'[^a-z0-9]+', '_', text_marker.lower())}.toml"
+    if not path.exists() or path.read_text() != text:
+        path.write_text(text)
     return path
 
 
@@ -88,36 +88,27 @@ def classify(name, backend, proc, summary, run_file):
 def run(ctx):
     # Column label -> (back-end, extra overrides). The TIN's default does not conserve volume
     # (as in the paper), so it also runs with tin.conserve_volume to show what else degrades.
-    columns = {"tin": ("tin", []), "tin conserve_volume": ("tin", ["tin.conserve_volume=true"]), "grid": ("grid", [])}
+    columns = {"tin": ("tin", []), "tin conserve_volume": ("tin", ["tin.conserve_volume=true"]), "grid": ("grid", []),
+               "sparse": ("sparse", [])}
     backends = list(columns)
     rows, outcomes = [], {}
-    out_dir = ctx.runs / "stability"
-    out_dir.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory() as tmp:
-        cases = {k: v for k, v in CASES.items() if k in ctx.profile.get("stability_cases", CASES)}
-        for name, (desc, overrides, bad_text) in cases.items():
-            for backend in backends:
-                engine, extra = columns[backend]
-                safe = backend.replace(" ", "_")
-                result_path = out_dir / f"{name}-{safe}.result.json"
-                if result_path.exists():
-                    res = json.loads(result_path.read_text())
-                else:
-                    scene = scene_with(bad_text, tmp) if bad_text else BASE
-                    run_file = out_dir / f"{name}-{safe}.h5"
-                    cmd = [str(ctx.sandbench), "run", str(scene), "--backend", engine, "--out", str(run_file),
-                           "--json"] + [a for o in overrides + extra for a in ("--set", o)]
-                    try:
-                        proc = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT_S)
-                        summary = json.loads(proc.stdout) if proc.returncode == 0 else {}
-                    except subprocess.TimeoutExpired:
-                        proc, summary = None, {}
-                    outcome, reason = classify(name, backend, proc, summary, run_file)
-                    res = {"outcome": outcome, "reason": reason}
-                    result_path.write_text(json.dumps(res))
-                sbrun.progress(f"  stability: {name} on {backend}: {res['outcome']}")
-                outcomes[(name, backend)] = res
-            rows.append([name, desc] + [outcomes[(name, b)]["outcome"] for b in backends])
+    scenes = ctx.runs / "stability" / "scenes"
+    scenes.mkdir(parents=True, exist_ok=True)
+    cases = {k: v for k, v in CASES.items() if k in ctx.profile.get("stability_cases", CASES)}
+    jobs, cells = [], []
+    for name, (desc, overrides, bad_text) in cases.items():
+        for backend in backends:
+            engine, extra = columns[backend]
+            scene = scene_with(bad_text, scenes) if bad_text else BASE
+            jobs.append((scene, engine, f"stability/{name}-{backend.replace(' ', '_')}", overrides + extra))
+            cells.append((name, backend))
+    # A failing run is a result here (refused, crashed), so check=False.
+    for (name, backend), res in zip(cells, ctx.run_many("stability", jobs, check=False, timeout=TIMEOUT_S)):
+        proc = None if res["exit"] is None else SimpleNamespace(returncode=res["exit"], stderr=res["stderr"])
+        outcome, reason = classify(name, backend, proc, res["summary"], None)
+        outcomes[(name, backend)] = {"outcome": outcome, "reason": reason}
+    for name, (desc, _, _) in cases.items():
+        rows.append([name, desc] + [outcomes[(name, b)]["outcome"] for b in backends])
     md = ctx.table("stability", ["case", "what", *backends], rows)
     reasons = [[name, b, outcomes[(name, b)]["outcome"], outcomes[(name, b)]["reason"]]
                for name in cases for b in backends if outcomes[(name, b)]["outcome"] != "ok"]

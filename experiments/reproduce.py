@@ -1,16 +1,22 @@
 #!/usr/bin/python3
 """The reproduction driver, run by `make reproduce`: every experiment at the paper's scale,
 figures and tables into results/, and results/REPORT.md that compares each claim of the
-paper with what we measured. Run files go to results/runs/ (not committed); complete runs
-are skipped, so an interrupted reproduction resumes and a second run is instant."""
+paper with what we measured. Run files go to results/runs/ (not committed).
+
+Each experiment declares its runs; the driver collects every run not yet done (by this
+binary, with these inputs) from all experiments, hands them to one engine -- `local` (a pool
+of --jobs on this machine) or `slurm` (one job array; see engines.py) -- and then lets the
+experiments aggregate. Finished runs are reused, so an interrupted reproduction resumes and
+a second one runs nothing."""
 import argparse
-import datetime
 import os
 import platform
+import resource
 import subprocess
 import time
 from pathlib import Path
 
+import engines
 import sbrun
 import exp_accuracy
 import exp_alpha_flat
@@ -20,6 +26,7 @@ import exp_fig7
 import exp_fig8_9
 import exp_haptics
 import exp_memory
+import exp_sparse
 import exp_stability
 
 EXPERIMENTS = {
@@ -27,6 +34,7 @@ EXPERIMENTS = {
     "fig7": exp_fig7,
     "fig8_9": exp_fig8_9,
     "memory": exp_memory,
+    "sparse": exp_sparse,
     "drift": exp_drift,
     "alpha_flat": exp_alpha_flat,
     "accuracy": exp_accuracy,
@@ -41,7 +49,8 @@ def package_version(name):
 
 
 def machine_header(ctx):
-    version = ctx.sandbench_cmd("--version").strip()
+    """The binary, the runs behind the numbers and the machine. Stable when nothing reran (no
+    date of today, no commit of HEAD), so a second reproduction leaves REPORT.md as it was."""
     cpu = "unknown"
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
@@ -53,11 +62,41 @@ def machine_header(ctx):
     compiler = subprocess.run(["c++", "--version"], capture_output=True, text=True).stdout.splitlines()[0]
     libs = ", ".join(f"{n} {package_version(p)}" for n, p in
                      [("CGAL", "libcgal-dev"), ("Eigen", "libeigen3-dev"), ("HDF5", "libhdf5-dev"),
-                      ("OSMesa", "libosmesa6-dev")])
-    return (f"- date: {datetime.date.today().isoformat()}; profile: {ctx.profile_name}\n"
-            f"- {version}, built with {compiler}\n"
+                      ("OSMesa", "libosmesa6-dev"), ("OpenVDB", "libopenvdb-dev")])
+    sides = list(ctx.used.values())
+    builds = sorted({s["binary"]["build_id"] for s in sides})
+    commits = sorted({s["binary"]["commit"] for s in sides})
+    dates = sorted(s["finished"] for s in sides)
+    runs = (f"- runs: {len(sides)} sandbench runs, all by build {', '.join(builds)} (commit {', '.join(commits)}), "
+            f"finished {dates[0]}..{dates[-1]}\n" if sides else "")
+    return (f"- profile: {ctx.profile_name}\n"
+            f"- binary: {ctx.binary['version']}; compiler {compiler}\n" + runs +
             f"- machine: {platform.machine()}, {cpu}, {len(os.sched_getaffinity(0))} cores; {platform.platform()}\n"
             f"- libraries: {libs}\n")
+
+
+def run_experiments(ctx, names):
+    """Each experiment's report section. Experiments raise MissingRuns until their runs are
+    done; all missing runs of a round go to the engine together (one job array on SLURM)."""
+    sections = {}
+    for round_ in range(1, 10):
+        missing = {}
+        for i, name in enumerate(names, 1):
+            if name in sections:
+                continue
+            start = time.monotonic()
+            try:
+                sections[name] = EXPERIMENTS[name].run(ctx)
+                sbrun.progress(f"[{i}/{len(names)}] {name} done in {time.monotonic() - start:.0f} s")
+            except sbrun.MissingRuns as m:
+                for spec in m.specs:
+                    missing.setdefault(spec["name"], spec)
+                sbrun.progress(f"[{i}/{len(names)}] {name}: {len(m.specs)} runs to do")
+        if not missing:
+            return [sections[n] for n in names]
+        sbrun.progress(f"round {round_}: {len(missing)} runs to do on the {ctx.engine.name} engine")
+        ctx.engine.execute(list(missing.values()), "runs")
+    raise RuntimeError("experiments still declare new runs after 9 rounds")
 
 
 INTRO = """The paper's setup: a square terrain whose diagonal is 1 m, a disk tool (radius 2 cm, 32-gon,
@@ -79,17 +118,36 @@ def main():
     ap.add_argument("--profile", default="paper", choices=sbrun.PROFILES)
     ap.add_argument("--full", action="store_true", help="the 'full' profile: sizes up to 1e6 vertices")
     ap.add_argument("--only", nargs="*", choices=EXPERIMENTS, help="run only these experiments")
+    ap.add_argument("--jobs", type=int, default=2, help="local engine: runs at once")
+    ap.add_argument("--engine", choices=["local", "slurm"], default="local",
+                    help="local: a pool on this machine; slurm: a job array through sbatch")
+    slurm = ap.add_argument_group("slurm engine (sbatch's defaults and SBATCH_* variables apply otherwise)")
+    slurm.add_argument("--partition")
+    slurm.add_argument("--account")
+    slurm.add_argument("--time", help="time limit of one array task, sbatch syntax (e.g. 00:30:00)")
+    slurm.add_argument("--mem", help="memory of one array task, sbatch syntax (e.g. 4G)")
+    slurm.add_argument("--parallel", type=int, default=32, help="array tasks at once (the %%N throttle)")
+    slurm.add_argument("--batch", type=int, default=1, help="runs per array task")
+    slurm.add_argument("--sbatch-arg", action="append", default=[], help="one more sbatch argument (repeatable)")
+    slurm.add_argument("--poll", type=float, default=5.0, help="seconds between squeue polls")
     args = ap.parse_args()
     sbrun.env_ok()
-    ctx = sbrun.Context(args.sandbench, args.results, "full" if args.full else args.profile)
-
-    sections = []
+    engine = None
+    if args.engine == "slurm":
+        engine = engines.SlurmEngine(args.partition, args.account, args.time, args.mem, args.parallel, args.batch,
+                                     args.sbatch_arg, args.poll)
+    ctx = sbrun.Context(args.sandbench, args.results, "full" if args.full else args.profile, args.jobs, engine)
+    ctx.defer = True
     names = args.only or list(EXPERIMENTS)
-    for i, name in enumerate(names, 1):
-        sbrun.progress(f"[{i}/{len(names)}] {name}")
-        start = time.monotonic()
-        sections.append(EXPERIMENTS[name].run(ctx))
-        sbrun.progress(f"[{i}/{len(names)}] {name} done in {time.monotonic() - start:.0f} s")
+    sbrun.progress(f"reproduce: {len(names)} experiments, profile {ctx.profile_name}, {ctx.engine.name} engine, "
+                   f"binary {ctx.binary['version']}")
+    start = time.monotonic()
+    sections = run_experiments(ctx, names)
+    cpu = resource.getrusage(resource.RUSAGE_CHILDREN)
+    sbrun.progress(f"reproduce: {time.monotonic() - start:.0f} s wall, {cpu.ru_utime + cpu.ru_stime:.0f} s CPU in "
+                   f"processes run on this machine")
+    if engine is not None:
+        sbrun.progress(f"slurm: waited for job arrays {' '.join(engine.job_ids) or '(none: every run was done)'}")
 
     if args.only:  # a partial run prints its sections; only a full run writes REPORT.md
         print("\n".join(sections))

@@ -1,19 +1,25 @@
-"""Shared helpers for the experiment scripts: run sandbench (resumably, two at a time),
+"""Shared helpers for the experiment scripts: declare sandbench runs and get their results,
 read run files, fit exponents, write figures (PNG and SVG) and tables (Markdown and CSV).
 
-A run is skipped when its run file and summary already exist: sandbench writes the run file
-under a temporary name and renames it when whole, and the summary is written after it, so an
-existing pair is a complete run and an interrupted reproduction resumes where it stopped.
+Runs are declared with Context.run_many(label, [(scene, backend, name, overrides)]): the
+declaration is the same whichever engine executes them (engines.py: `local`, a thread pool;
+`slurm`, a job array). A finished run is reused only when its key matches: the binary's build
+identity and the run's inputs (runstore.py), so results always come from the binary at hand.
+
+Two ways to run: an experiment script on its own executes its missing runs at once (local
+engine); the reproduction driver sets `defer`, so run_many raises MissingRuns for every run
+not yet done, the driver collects them from all experiments, hands them to the engine in one
+go and calls the experiments again to aggregate (see reproduce.py).
 """
-import concurrent.futures
 import csv
-import json
 import math
 import os
 import subprocess
 import sys
-import threading
 from pathlib import Path
+
+import engines
+import runstore
 
 ROOT = Path(__file__).resolve().parent.parent
 SCENES = ROOT / "experiments" / "scenes"
@@ -36,59 +42,76 @@ PROFILES = {
 }
 
 
-def progress(message):
-    sys.stderr.write(message + "\n")
-    sys.stderr.flush()
+progress = engines.progress
+
+
+class MissingRuns(Exception):
+    """Raised by run_many in deferred mode: these runs must be executed first."""
+
+    def __init__(self, specs):
+        super().__init__(f"{len(specs)} runs to execute")
+        self.specs = specs
 
 
 class Context:
-    """Where an experiment reads and writes, and how it runs sandbench."""
+    """Where an experiment reads and writes, and how its runs are executed."""
 
-    def __init__(self, sandbench, results, profile="paper", jobs=2):
+    def __init__(self, sandbench, results, profile="paper", jobs=2, engine=None):
         self.sandbench = Path(sandbench)
         self.results = Path(results)
         self.runs = self.results / "runs"
         self.profile_name = profile
         self.profile = PROFILES[profile]
-        self.jobs = jobs
+        self.engine = engine or engines.LocalEngine(jobs)
+        self.defer = False  # set by the driver: collect missing runs instead of executing them
         self.results.mkdir(parents=True, exist_ok=True)
-        self._lock = threading.Lock()
+        self.runs.mkdir(parents=True, exist_ok=True)
+        self.binary = runstore.binary_identity(self.sandbench)
+        self.used = {}  # name -> sidecar of every run whose result was handed out
+
+    def spec(self, scene, backend, name, overrides=(), check=True, timeout=None):
+        return runstore.make_spec(self.sandbench, self.binary, self.runs, scene, backend, name, overrides, check,
+                                  timeout)
 
     def run(self, scene, backend, name, overrides=()):
-        """One sandbench run (skipped when complete); returns its summary dict."""
-        out = self.runs / f"{name}.h5"
-        summary_path = self.runs / f"{name}.json"
-        if out.exists() and summary_path.exists():
-            return json.loads(summary_path.read_text())
-        out.parent.mkdir(parents=True, exist_ok=True)
-        cmd = [str(self.sandbench), "run", str(scene), "--backend", backend, "--out", str(out), "--json"]
-        for o in overrides:
-            cmd += ["--set", o]
-        proc = subprocess.run(cmd, capture_output=True, text=True)
-        if proc.returncode != 0:
-            raise RuntimeError(f"sandbench failed ({proc.returncode}): {' '.join(cmd)}\n{proc.stderr}")
-        summary = json.loads(proc.stdout)
-        tmp = summary_path.with_name(summary_path.name + ".tmp")
-        tmp.write_text(json.dumps(summary, indent=2) + "\n")
-        tmp.replace(summary_path)
-        return summary
+        """One sandbench run (reused when done by this binary with these inputs); its summary."""
+        return self.run_many(name, [(scene, backend, name, overrides)])[0]
 
-    def run_many(self, label, jobs):
-        """Runs jobs [(scene, backend, name, overrides)] two at a time; returns summaries in order."""
-        results = [None] * len(jobs)
-        done = [0]
-
-        def one(i):
-            scene, backend, name, overrides = jobs[i]
-            results[i] = self.run(scene, backend, name, overrides)
-            with self._lock:
-                done[0] += 1
-                progress(f"  {label}: {done[0]}/{len(jobs)} {name}")
-
-        with concurrent.futures.ThreadPoolExecutor(max_workers=self.jobs) as pool:
-            for f in [pool.submit(one, i) for i in range(len(jobs))]:
-                f.result()
+    def run_many(self, label, jobs, check=True, timeout=None):
+        """Declares runs [(scene, backend, name, overrides)] and returns their summaries in order.
+        With check=False a failing run is a result, not an error: each result is then
+        {"exit": code (None: over `timeout` seconds), "stderr": its end, "summary": {} unless 0}."""
+        specs = [self.spec(*job, check=check, timeout=timeout) for job in jobs]
+        missing = [s for s in specs if not runstore.read_sidecar(s)]
+        if missing and self.defer:
+            raise MissingRuns(missing)
+        if missing:
+            progress(f"  {label}: {len(missing)} of {len(specs)} runs to do")
+            self.engine.execute(missing, label)
+        results = []
+        for s in specs:
+            side = runstore.read_sidecar(s)
+            if side is None:
+                raise RuntimeError(f"run {s['name']} left no result (see the messages above)")
+            self.used[s["name"]] = side
+            results.append(side["summary"] if check else side)
         return results
+
+    def is_current(self, folder, what):
+        """Whether FOLDER was made by this binary from WHAT (a list of strings and files), as
+        recorded by mark_current: for outputs that are not run files (a `compare` folder)."""
+        try:
+            return (Path(folder) / ".identity").read_text() == self._identity_of(what)
+        except OSError:
+            return False
+
+    def mark_current(self, folder, what):
+        (Path(folder) / ".identity").write_text(self._identity_of(what))
+
+    def _identity_of(self, what):
+        parts = [self.binary["build_id"]]
+        parts += [runstore.sha256_file(w) if isinstance(w, Path) else str(w) for w in what]
+        return "\n".join(parts) + "\n"
 
     def sandbench_cmd(self, *args):
         proc = subprocess.run([str(self.sandbench), *map(str, args)], capture_output=True, text=True)
@@ -97,7 +120,8 @@ class Context:
         return proc.stdout
 
     def figure(self, fig, name):
-        """Saves a matplotlib figure as results/NAME.png and .svg; returns the PNG's name."""
+        """Saves a matplotlib figure as results/NAME.png and .svg; returns the PNG's name. The
+        same figure gives the same bytes (no date, fixed SVG ids: see env_ok)."""
         for ext in ("png", "svg"):
             tmp = self.results / f"{name}.tmp.{ext}"
             fig.savefig(tmp, dpi=120, bbox_inches="tight", metadata={"Date": None} if ext == "svg" else None)
@@ -165,12 +189,15 @@ def read_h5(path):
 def env_ok():
     try:
         import h5py  # noqa: F401
-        import matplotlib  # noqa: F401
+        import matplotlib
         import numpy  # noqa: F401
     except ImportError as e:
         sys.exit(f"experiments need Debian's python3-numpy, python3-matplotlib and python3-h5py on "
                  f"/usr/bin/python3 ({e}); run `make deps`")
     os.environ.setdefault("MPLBACKEND", "Agg")
+    # SVG element ids are random unless salted: a fixed salt makes a figure's SVG the same
+    # bytes every time, so regenerating results from cached runs leaves git status clean.
+    matplotlib.rcParams["svg.hashsalt"] = "sandbench"
 
 
 def main(run):

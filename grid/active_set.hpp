@@ -1,69 +1,162 @@
 #pragma once
-// ActiveSet: the nodes erosion visits (the paper's list L_e), in a deterministic order.
+// ActiveSet: the nodes erosion visits (the paper's list L_e), as a bitmap over the grid's
+// rows, visited in storage order.
 //
-// A list of node indices plus one 16-bit state per node (a membership bit and the count of
-// consecutive idle visits). A pass takes the list out (begin_pass) and refills it: a node
-// that transferred, and its neighbours, come back with a fresh idle count; an idle node
-// comes back until it has been idle `idle_passes` times in a row. Order = order of
-// insertion, so the same input gives the same sequence of visits.
+// Membership is one bit per node, rows padded to whole 64-bit words, plus a member count
+// per row; each member also keeps a 16-bit count of consecutive idle visits (a non-member's
+// count is 0), held by the Idle policy: DenseIdleCounts, 16 bits per node (the dense grid),
+// or BitPlaneIdleCounts, as many bits per node as idle_passes needs (the sparse grid,
+// sparse_idle_counts.hpp). The policy changes only where the counts live. A node that
+// transferred, and its 3 x 3 block, become members with a fresh idle count; an idle node
+// stays until it has been idle `idle_passes` times in a row.
 //
-// Memory: 2 bytes per node, plus 4 bytes per entry of the two index lists (their
-// high-water mark). activate / idle / keep are O(1); begin_pass is O(list).
+// Sweeps are ordered and live (avalanche order): a sweep walks the rows and the words in a
+// direction that alternates between sweeps (+y +x, -y -x, +y -x, -y +x), and a node that
+// becomes a member ahead of the cursor is visited in the same sweep. A run of unstable
+// nodes down a slope in the sweep's direction therefore moves in one pass, instead of one
+// node per pass; this is what keeps the passes needed to settle from growing with the
+// resolution (erosion_kernel.hpp). The order depends only on the heights and the pass
+// number, so the same input gives the same sequence of visits.
+//
+// Memory: 1 bit per node and 4 bytes per row, plus the counts: 2 bytes per node (dense),
+// or bit_width(idle_passes - 1) bits per node (bit planes; 1 bit for the default 2).
+// activate_block / idle are O(1); a sweep is O(rows + words of rows with members + visits).
+#include <bit>
 #include <cstddef>
 #include <cstdint>
-#include <span>
 #include <string>
 #include <vector>
 
 namespace sb::grid {
 
-class ActiveSet {
+// One idle count per node.
+class DenseIdleCounts {
  public:
-  ActiveSet(std::size_t nodes, int idle_passes);
-
-  // Node k changed (or a neighbour of it did): in the set, idle count reset.
-  void activate(std::uint32_t k) {
-    if (!(state_[k] & kMember)) list_.push_back(k);
-    state_[k] = kMember;
+  DenseIdleCounts(std::size_t nx, std::size_t ny, std::size_t /*words_per_row*/, std::uint16_t /*idle_passes*/)
+      : nx_(nx), counts_(nx * ny, 0) {}
+  // One more idle visit; true (and the count back to 0) when it makes idle_passes.
+  bool count_up(std::size_t ix, std::size_t iy, std::uint16_t idle_passes) {
+    std::uint16_t& count = counts_[iy * nx_ + ix];
+    if (++count < idle_passes) return false;
+    count = 0;
+    return true;
   }
-  // Node k was visited and stayed put: one more idle visit; it leaves at idle_passes,
-  // unless a neighbour brought it back during this pass.
-  void idle(std::uint32_t k) {
-    if (state_[k] & kMember) return;
-    const std::uint16_t count = static_cast<std::uint16_t>(state_[k] + 1);
-    if (count < idle_passes_) {
-      state_[k] = count | kMember;
-      list_.push_back(k);
-    } else {
-      state_[k] = 0;  // left the set; a non-member's state is always 0
+  // Counts of nodes x0..x1 of row y back to 0.
+  void reset(std::size_t y, std::size_t x0, std::size_t x1) {
+    for (std::size_t x = x0; x <= x1; ++x) counts_[y * nx_ + x] = 0;
+  }
+  std::size_t bytes() const { return counts_.capacity() * sizeof(std::uint16_t); }
+  // Counts below idle_passes, zero for non-members.
+  void check(const std::vector<std::uint64_t>& bits, std::size_t words_per_row, std::uint16_t idle_passes,
+             std::vector<std::string>& problems) const;
+
+ private:
+  std::size_t nx_;
+  std::vector<std::uint16_t> counts_;
+};
+
+template <class Idle>
+class BasicActiveSet {
+ public:
+  BasicActiveSet(std::size_t nx, std::size_t ny, int idle_passes);
+
+  // Node (ix, iy) changed: it and its 3 x 3 block (clipped to the grid) become members
+  // with a fresh idle count.
+  void activate_block(std::size_t ix, std::size_t iy) {
+    const std::size_t y0 = iy > 0 ? iy - 1 : 0, y1 = iy + 1 < ny_ ? iy + 1 : iy;
+    const std::size_t x0 = ix > 0 ? ix - 1 : 0, x1 = ix + 1 < nx_ ? ix + 1 : ix;
+    for (std::size_t y = y0; y <= y1; ++y) {
+      set_bits(y, x0, x1);
+      idle_.reset(y, x0, x1);
     }
   }
-  // Node k was not visited (the budget ran out): it stays as it was.
-  void keep(std::uint32_t k) {
-    if (state_[k] & kMember) return;
-    state_[k] |= kMember;
-    list_.push_back(k);
+  // Node (ix, iy) alone becomes a member with a fresh idle count.
+  void activate(std::size_t ix, std::size_t iy) {
+    set_bits(iy, ix, ix);
+    idle_.reset(iy, ix, ix);
+  }
+  // Node (ix, iy) was visited and stayed put: it leaves after idle_passes such visits in a row.
+  void idle(std::size_t ix, std::size_t iy) {
+    if (!idle_.count_up(ix, iy, idle_passes_)) return;
+    std::uint64_t& w = bits_[iy * words_per_row_ + ix / 64];
+    w &= ~(std::uint64_t{1} << (ix % 64));
+    --row_count_[iy];
+    --size_;
   }
 
-  // Hands out the current members for one pass and empties the set; the pass refills it
-  // through activate / idle / keep. The span stays valid until the next begin_pass.
-  std::span<const std::uint32_t> begin_pass();
+  // One ordered, live sweep (see above); direction from the pass number. Calls
+  // visit(ix, iy), which returns true when the node transferred (the caller then activates
+  // its block) -- the set marks idle nodes itself. Stops after max_visits visits; the
+  // nodes not reached stay members. Returns the number of visits.
+  template <class Visit>
+  std::size_t sweep(std::size_t max_visits, Visit&& visit);
 
-  bool empty() const { return list_.empty(); }
-  std::size_t size() const { return list_.size(); }
-  std::span<const std::uint32_t> members() const { return list_; }
-  bool contains(std::uint32_t k) const { return state_[k] & kMember; }
+  bool empty() const { return size_ == 0; }
+  std::size_t size() const { return size_; }
+  bool contains(std::size_t ix, std::size_t iy) const {
+    return (bits_[iy * words_per_row_ + ix / 64] >> (ix % 64)) & 1u;
+  }
+  bool contains(std::uint32_t k) const { return contains(k % nx_, k / nx_); }
   std::size_t bytes() const;
-  // Bookkeeping invariants: every listed node flagged once, every flag listed, idle
-  // counts below idle_passes, non-members zero. O(nodes).
+  // Bookkeeping invariants: row counts and the total match the bits, padding bits clear,
+  // idle counts below idle_passes. O(nodes).
   void check(std::vector<std::string>& problems) const;
 
  private:
-  static constexpr std::uint16_t kMember = 0x8000;
-  int idle_passes_;
-  std::vector<std::uint16_t> state_;     // kMember | idle count, per node
-  std::vector<std::uint32_t> list_;      // members, in visiting order
-  std::vector<std::uint32_t> visiting_;  // the pass in progress
+  void set_bits(std::size_t y, std::size_t x0, std::size_t x1) {
+    // x1 - x0 <= 2: the bits span at most two words.
+    std::uint64_t* row = bits_.data() + y * words_per_row_;
+    for (std::size_t x = x0; x <= x1;) {
+      const std::size_t wi = x / 64, lo = x % 64, hi = std::min<std::size_t>(63, lo + (x1 - x));
+      const std::uint64_t mask =
+          (hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & ~((std::uint64_t{1} << lo) - 1);
+      const int added = std::popcount(mask & ~row[wi]);
+      row[wi] |= mask;
+      row_count_[y] += static_cast<std::uint32_t>(added);
+      size_ += static_cast<std::size_t>(added);
+      x += hi - lo + 1;
+    }
+  }
+
+  std::size_t nx_, ny_, words_per_row_;
+  std::uint16_t idle_passes_;
+  std::size_t size_ = 0;
+  unsigned sweeps_ = 0;                   // sweeps so far: chooses the next sweep's direction
+  std::vector<std::uint64_t> bits_;       // membership, row-major, rows padded to words
+  std::vector<std::uint32_t> row_count_;  // members per row
+  Idle idle_;                             // consecutive idle visits of the members
 };
+
+template <class Idle>
+template <class Visit>
+std::size_t BasicActiveSet<Idle>::sweep(std::size_t max_visits, Visit&& visit) {
+  const unsigned pass = sweeps_++;
+  const bool y_up = pass % 2 == 0;
+  const bool x_up = (pass / 2) % 2 == 0;
+  std::size_t visits = 0;
+  for (std::size_t r = 0; r < ny_; ++r) {
+    const std::size_t iy = y_up ? r : ny_ - 1 - r;
+    // Live: a node activated in this row (or the next ones) ahead of the cursor is seen.
+    if (row_count_[iy] == 0) continue;
+    const std::uint64_t* row = bits_.data() + iy * words_per_row_;
+    for (std::size_t c = 0; c < words_per_row_; ++c) {
+      const std::size_t wi = x_up ? c : words_per_row_ - 1 - c;
+      // Bits of this word still ahead of the cursor.
+      std::uint64_t ahead = ~std::uint64_t{0};
+      while (const std::uint64_t live = row[wi] & ahead) {
+        if (visits == max_visits) return visits;
+        const int b = x_up ? std::countr_zero(live) : 63 - std::countl_zero(live);
+        ahead = x_up ? (b == 63 ? 0 : ~std::uint64_t{0} << (b + 1)) : ((std::uint64_t{1} << b) - 1);
+        const std::size_t ix = wi * 64 + static_cast<std::size_t>(b);
+        ++visits;
+        if (!visit(ix, iy)) idle(ix, iy);
+      }
+    }
+  }
+  return visits;
+}
+
+using ActiveSet = BasicActiveSet<DenseIdleCounts>;
+extern template class BasicActiveSet<DenseIdleCounts>;
 
 }  // namespace sb::grid

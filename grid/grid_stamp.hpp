@@ -15,9 +15,10 @@
 
 namespace sb::grid {
 
-// Applies one stamp. Appends every node whose height changed to `changed`.
+// Applies one stamp to a Store (stamp_kernel.hpp's concept; instantiated for HeightGrid<float>
+// and HeightGrid<double>). Appends every node whose height changed to `changed`.
 // Volume: removed == deposited (to rounding); a pour adds s.pour_volume_m3.
-template <class Real>
-StampReport stamp_grid(HeightGrid<Real>& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed);
+template <class Store>
+StampReport stamp_grid(Store& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed);
 
 }  // namespace sb::grid

@@ -7,12 +7,13 @@
 // border axis, so volume() = sum A_k z_k is the interpolant's exact integral. Tool stamps
 // cut the footprint to the tool bottom and put exactly that volume on the rim band
 // (grid_stamp.hpp); erosion applies sb::erosion_transfers over an active set with an
-// 8- or 4-neighbour stencil (grid_erosion.hpp, active_set.hpp).
+// 8- or 4-neighbour stencil (erosion_kernel.hpp, active_set.hpp).
 //
 // Memory per node: sizeof(Real) for the height + 2 for the active-set state, i.e.
 //   double: 10 bytes/node,  float: 6 bytes/node,
-// plus 8 bytes per active node (two index lists, at their high-water mark). A 512 x 512
-// grid is 2.6 MB in double, 1.6 MB in float.
+// plus 8 bytes per active node (two index lists, at their high-water mark) and, once erosion
+// has run, its node-class tables (at most 25 classes, < 8 kB). A 512 x 512 grid is 2.6 MB
+// in double, 1.6 MB in float.
 // Volume drift after 1000 stamps with erosion (a disk tool over flat sand, measured in
 // tests/unit/grid_volume_test.cpp): double 0, float 1.4e-16 relative -- both at the
 // resolution of the volume sum itself. Float writes carry their rounding error on
@@ -27,20 +28,33 @@
 //   stamp                       O(w), plus O(v) per node near the footprint's boundary
 //                               or in the rim band; pour O(nodes within its radius)
 //   erode                       O(passes * a * stencil); never the whole grid
+//                               (erosion_kernel.hpp: node-class tables, built once per rule)
 //   simplify                    O(1), nothing to simplify on a grid
 //   volume, max_slope_deg,
 //   mesh, check                 O(n)
+//   stream_mesh                 O(n) time, O(nx) memory (the run file's writer)
 //   stats                       O(1)
-// Measured (tests/bench/grid_bench.cpp, 512 x 512, one 2.6 GHz core, CPU time): erosion
-// 26-29 M node updates/s in double, 20-24 M in float (the rounding carry costs ~25 %);
-// a stamp ~80 ns per node of its window, e.g. 3 ms for a 64-cell (32 cm) disk.
+// Each stamp and erode reports its exact volume change (volume_change_m3: the stamp's own
+// sums, and the rounding carry), so the runner never integrates the grid per step.
+// Measured (tests/bench/grid_bench.cpp, one shared core of a loaded 2-vCPU VM, CPU time,
+// medians of 5, main and this kernel interleaved): erosion 23 M node updates/s on the pile
+// and stroke states in double (main: 22-24 M/s, unchanged: the visits of a scattered active
+// set wait on memory, not on arithmetic), 22 M/s with every node of 2048^2 active against
+// 18 M/s for the plain scalar reference sweep (BM_ReferenceSweep, 1.2x); a stamp ~80 ns per
+// node of its window, e.g. 3 ms for a 64-cell (32 cm) disk.
+// Settling (relax_at_end) is diffusive near the critical angle: on flat_stroke.toml the
+// passes to settle grow 3.4-3.8x per halving of the cell (163, 552, 2077 at 2.5, 1.25,
+// 0.625 mm), the settling updates ~16x; neither a larger transfer fraction (1.9: 49, 157, 537
+// passes) nor index-ordered sweeps change that exponent. See README, "Grid erosion".
 #include <functional>
 #include <memory>
+#include <optional>
 
 #include "common/height_field.hpp"
 #include "common/scene.hpp"
 #include "common/terrain.hpp"
 #include "grid/active_set.hpp"
+#include "grid/erosion_kernel.hpp"
 #include "grid/height_grid.hpp"
 #include "grid/stencil.hpp"
 
@@ -61,6 +75,7 @@ class GridTerrain final : public Terrain {
   double volume() const override { return grid_.volume(); }
   ModelStats stats() const override;
   SurfaceMesh mesh() const override;
+  void stream_mesh(MeshSink& sink) const override;  // O(n) time, O(nx) memory
   void sample(Raster& out) const override;
   IntegrityReport check() const override;
   double max_slope_deg() const override;
@@ -75,6 +90,7 @@ class GridTerrain final : public Terrain {
   HeightGrid<Real> grid_;
   Stencil stencil_;
   ActiveSet active_;
+  std::optional<ErosionTables> tables_;  // built on the first erode, rebuilt when the rule changes
 };
 
 extern template class GridTerrain<float>;

@@ -15,9 +15,9 @@
 #include <type_traits>
 #include <vector>
 
-#include "common/bilinear.hpp"
-#include "grid/compensated_sum.hpp"
 #include "grid/grid_layout.hpp"
+#include "grid/height_queries.hpp"
+#include "grid/rounding_carry.hpp"
 
 namespace sb::grid {
 
@@ -36,55 +36,36 @@ class HeightGrid {
 
   const GridLayout& layout() const { return layout_; }
   const std::vector<Real>& heights() const { return z_; }
-  double z(std::uint32_t k) const { return static_cast<double>(z_[k]); }
-  double z(std::size_t ix, std::size_t iy) const { return z(layout_.index(ix, iy)); }
+  double z(std::size_t ix, std::size_t iy) const { return z(std::size_t{layout_.index(ix, iy)}); }
 
   // Stores `target` (m) at node k; with float storage the rounding error is carried on.
   void set(std::uint32_t k, double target) { set(k, target, layout_.area(k)); }
   // The same, for callers that know the node's area (layout().area(k)) already.
-  void set(std::uint32_t k, double target, double area) {
-    if constexpr (std::is_same_v<Real, double>) {
-      (void)area;
-      z_[k] = target;
-    } else {
-      // 1 / area does not depend on the carry, so it is computed off the carry's chain of
-      // dependent operations, which runs through every float write.
-      const double inverse_area = 1.0 / area;
-      const double wanted = target + carry_m3_ * inverse_area;
-      const Real stored = static_cast<Real>(wanted);
-      carry_m3_ = (wanted - static_cast<double>(stored)) * area;
-      z_[k] = stored;
-    }
-  }
+  void set(std::uint32_t k, double target, double area) { z_[k] = carry_.round(target, area); }
   // Volume (m^3) owed to the surface by rounding: true volume = volume() + carry_m3().
-  double carry_m3() const { return carry_m3_; }
+  double carry_m3() const { return carry_.m3(); }
 
-  // Bilinear interpolation of the node heights, p clamped to the domain. O(1).
-  double height(const Vec2& p) const {
-    return bilinear((p.x() - layout_.origin.x()) / layout_.dx, (p.y() - layout_.origin.y()) / layout_.dy, layout_.nx,
-                    layout_.ny,
-                    [&](std::size_t ix, std::size_t iy) { return static_cast<double>(z_[iy * layout_.nx + ix]); });
+  // The erosion kernel's storage concept (erosion_kernel.hpp): a plain rounded store that
+  // returns its rounding error (m), and the carry, which the kernel settles itself.
+  static constexpr bool kRounds = !std::is_same_v<Real, double>;
+  double z(std::size_t k) const { return static_cast<double>(z_[k]); }
+  double put(std::size_t k, double target) {
+    const Real stored = static_cast<Real>(target);
+    z_[k] = stored;
+    if constexpr (kRounds) return target - static_cast<double>(stored);
+    return 0.0;
   }
+  double& carry() { return carry_.m3(); }
 
-  // The exact integral of the bilinear interpolant over the domain: sum of A_k z_k with
-  // the trapezoid weights, summed with compensation. O(nodes).
-  double volume() const {
-    CompensatedSum total;
-    for (std::size_t iy = 0; iy < layout_.ny; ++iy) {
-      CompensatedSum row;
-      const Real* z = z_.data() + iy * layout_.nx;
-      for (std::size_t ix = 0; ix < layout_.nx; ++ix) row.add(layout_.weight_x(ix) * static_cast<double>(z[ix]));
-      total.add(layout_.weight_y(iy) * row.value());
-    }
-    return total.value();
-  }
+  double height(const Vec2& p) const { return bilinear_height(*this, p); }
+  double volume() const { return trapezoid_volume(*this); }
 
   std::size_t bytes() const { return z_.capacity() * sizeof(Real); }
 
  private:
   GridLayout layout_;
   std::vector<Real> z_;
-  double carry_m3_ = 0.0;
+  RoundingCarry<Real> carry_;
 };
 
 }  // namespace sb::grid

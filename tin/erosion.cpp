@@ -20,7 +20,8 @@ double TinTerrain::gather_neighbours(VertexHandle v) {
     if (cdt_.is_infinite(c)) continue;
     const VertexHandle w = c;
     vertex_scratch_.push_back(w);
-    nbr_scratch_.push_back({w->point().z(), (xy(w) - p).norm(), cached_area(w)});
+    const Vec2 e = xy(w) - p;
+    nbr_scratch_.push_back({w->point().z(), e.norm(), cached_area(w), e.x(), e.y()});
   } while (++c != done);
   return cached_area(v);
 }
@@ -75,6 +76,11 @@ ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& bu
     throw InputError("erosion: the rule's slopes and fraction must be finite and non-negative");
   ErosionReport report;
   std::vector<VertexHandle>& work = work_scratch_;
+  // The gradient rule's input: the area-weighted facet gradients of v's star (gather_neighbours
+  // lists the neighbours counter-clockwise, so consecutive ones span v's triangles).
+  const auto gradient_at = [&](VertexHandle v) {
+    return rule.needs_gradient() ? fan_gradient(v->point().z(), nbr_scratch_) : SurfaceGradient{};
+  };
   for (int pass = 0; pass < budget.max_passes && !erosion_list_.empty() && report.updates < budget.max_updates;
        ++pass) {
     ++report.passes;
@@ -85,7 +91,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& bu
       ++report.updates;
       double area = gather_neighbours(v);
       transfer_scratch_.resize(nbr_scratch_.size());
-      double total = erosion_transfers(v->point().z(), area, nbr_scratch_, rule, transfer_scratch_);
+      double total = erosion_transfers(v->point().z(), area, gradient_at(v), nbr_scratch_, rule, transfer_scratch_);
       // Sand moving between vertices with long edges would spread over far-reaching
       // triangles: refine the stars of the giver and the receivers first, then recompute.
       for (int round = 0; round < 3 && total > 0.0; ++round) {
@@ -95,7 +101,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& bu
         if (splits == 0) break;
         area = gather_neighbours(v);
         transfer_scratch_.resize(nbr_scratch_.size());
-        total = erosion_transfers(v->point().z(), area, nbr_scratch_, rule, transfer_scratch_);
+        total = erosion_transfers(v->point().z(), area, gradient_at(v), nbr_scratch_, rule, transfer_scratch_);
       }
       // Settling criterion (slope excess): the rule moves nothing where every slope is below
       // tan_settle (erosion.settle_tolerance_deg above critical); a transfer removes a fixed

@@ -7,6 +7,7 @@
 // rim band by the common rule (ToolStamp::rim_weight). Old constraints within reach of O are
 // dropped before anything is inserted, so new constraints never touch or cross old ones.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -135,6 +136,14 @@ double TinTerrain::drop_stale_constraints(std::uint32_t generation) {
     stale.emplace_back(handle(key.a), handle(key.b));
   }
   if (stale.empty()) return 0.0;
+  // The hash map's order follows vertex addresses, which differ between processes: sort by
+  // position so that the flips after unconstraining, and so every run, are reproducible.
+  const auto by_position = [this](const std::pair<VertexHandle, VertexHandle>& p) {
+    const Vec2 a = xy(p.first), b = xy(p.second);
+    const bool swap = std::make_pair(b.x(), b.y()) < std::make_pair(a.x(), a.y());
+    return swap ? std::array<double, 4>{b.x(), b.y(), a.x(), a.y()} : std::array<double, 4>{a.x(), a.y(), b.x(), b.y()};
+  };
+  std::sort(stale.begin(), stale.end(), [&](const auto& l, const auto& r) { return by_position(l) < by_position(r); });
   Aabb2 box{xy(stale.front().first), xy(stale.front().first)};
   for (const auto& [a, b] : stale) box = unite(box, bounds(std::vector<Vec2>{xy(a), xy(b)}));
   const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());

@@ -1,4 +1,4 @@
-// `sandbench compare SCENE [--backends tin,grid] [--out DIR] [--json] [--set k=v ...]
+// `sandbench compare SCENE [--backends tin,grid,sparse] [--out DIR] [--json] [--set k=v ...]
 //  [--unset key ...] [--replay SESSION]`:
 // the same schedule on each back-end (or back-end variant), a table, the summaries and pictures.
 #include <fstream>
@@ -82,7 +82,7 @@ std::string markdown_table(const std::vector<VariantRun>& runs) {
 
 void compare_command(const CompareOptions& o) {
   std::vector<Variant> variants;
-  for (const auto& item : split(o.backends.empty() ? "tin,grid" : o.backends, ','))
+  for (const auto& item : split(o.backends.empty() ? "tin,grid,sparse" : o.backends, ','))
     variants.push_back(parse_variant(item, "--backends"));
   if (variants.empty()) throw InputError("--backends is empty; give e.g. tin,grid");
   const std::filesystem::path dir = o.out;
@@ -135,8 +135,12 @@ void compare_command(const CompareOptions& o) {
     write_text_atomically(dir / "summary.json", report.dump(2) + "\n");
     write_text_atomically(dir / "table.md", table);
     std::vector<PictureRun> pictures;
-    for (const auto& r : runs)
-      pictures.push_back({r.run.label, &r.run.final_mesh, &r.run.initial_raster, &r.run.final_raster, &r.summary});
+    std::vector<SurfaceMesh> meshes;
+    meshes.reserve(runs.size());
+    for (const auto& r : runs) {
+      meshes.push_back(r.run.final_surface());
+      pictures.push_back({r.run.label, &meshes.back(), &r.run.initial_raster, &r.run.final_raster, &r.summary});
+    }
     write_compare_pictures(dir, pictures);
     std::filesystem::remove(marker);
     std::cerr << "wrote " << dir.string() << "/{*.h5,summary.json,table.md,side_by_side.png"
@@ -155,7 +159,7 @@ void add_compare_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("compare", "Run the same schedule on several back-ends and compare them");
   cmd->add_option("scene", opts->scene, "Scene file (TOML)")->required();
   cmd->add_option("--backends", opts->backends,
-                  "Comma-separated back-ends or variants (default tin,grid), e.g. grid,grid:grid.storage=float");
+                  "Comma-separated back-ends or variants (default tin,grid,sparse), e.g. grid,grid:grid.storage=float");
   cmd->add_option("--out", opts->out,
                   "Directory for run files, summary.json, table.md, side_by_side.png and difference.png")
       ->check(output_directory());

@@ -29,7 +29,8 @@ CLI::App* find_command(CLI::App& app, const std::string& name) {
 
 int main(int argc, char** argv) {
   CLI::App app{"sandbench: TIN vs grid terrains for interactive sand manipulation"};
-  app.set_version_flag("-V,--version", std::string("sandbench ") + sb::kVersion);
+  app.set_version_flag("-V,--version", std::string("sandbench ") + sb::kVersion + " commit " + sb::kCommit + " build " +
+                                           sb::kBuildId + " (" + sb::kCompiler + ", " + sb::kBuildType + ")");
   app.require_subcommand(1);
   sb::cli::add_run_command(app);
   sb::cli::add_compare_command(app);

@@ -34,7 +34,7 @@ Simulation::Simulation(const PreparedScene& prepared, std::unique_ptr<Terrain> t
   active_.tool = prepared.scene.tool;
   active_.erosion_passes = prepared.scene.erosion.max_passes_per_step;
   controls_ = active_;
-  rule_ = ErosionRule::from(active_.material, prepared.scene.erosion.settle_tolerance_deg);
+  rule_ = ErosionRule::from(active_.material, prepared.scene.erosion.settle_tolerance_deg, prepared.scene.erosion.rule);
   params_ = haptics::ForceParams::from(active_.material, active_.tool);
   layout_ = haptics::PatchLayout::for_tool(params_.reach_m, patch_margin(params_.reach_m));
   haptics::reserve_patches(patches_, layout_.cells);
@@ -118,7 +118,8 @@ void Simulation::step() {
       std::lock_guard lock(mutex_);
       active_ = controls_;
     }
-    rule_ = ErosionRule::from(active_.material, prepared_.scene.erosion.settle_tolerance_deg);
+    rule_ =
+        ErosionRule::from(active_.material, prepared_.scene.erosion.settle_tolerance_deg, prepared_.scene.erosion.rule);
     params_ = haptics::ForceParams::from(active_.material, active_.tool, heading_rad_);
     active_set_ = 1;  // a new critical angle may unsettle the sand
     layout_ = haptics::PatchLayout::for_tool(params_.reach_m, patch_margin(params_.reach_m));

@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <cstring>
 #include <ctime>
+#include <optional>
+#include <span>
 #include <stdexcept>
 
 #include "common/atomic_file.hpp"
@@ -27,7 +29,10 @@ class Handle {
   }
   Handle(const Handle&) = delete;
   Handle& operator=(const Handle&) = delete;
-  ~Handle() { close_(id_); }
+  Handle(Handle&& other) noexcept : id_(other.id_), close_(other.close_) { other.id_ = -1; }
+  ~Handle() {
+    if (id_ >= 0) close_(id_);
+  }
   operator hid_t() const { return id_; }
 
  private:
@@ -89,9 +94,10 @@ void double_attribute(hid_t obj, const std::string& name, const std::vector<doub
   check(H5Awrite(attr, H5T_NATIVE_DOUBLE, values.data()), "write attribute " + name);
 }
 
-template <typename T>
-void dataset(hid_t parent, const std::string& name, hid_t mem_type, const T* data, std::vector<hsize_t> dims,
-             hid_t file_type = -1) {
+// Creates a dataset of the given shape (file type: the memory type unless given), chunked and
+// compressed when large.
+Handle create_dataset(hid_t parent, const std::string& name, hid_t mem_type, const std::vector<hsize_t>& dims,
+                      hid_t file_type = -1) {
   Handle space(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr), H5Sclose, "create space");
   Handle plist(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "create property list");
   std::size_t count = 1;
@@ -102,11 +108,60 @@ void dataset(hid_t parent, const std::string& name, hid_t mem_type, const T* dat
     check(H5Pset_chunk(plist, static_cast<int>(chunk.size()), chunk.data()), "chunk " + name);
     check(H5Pset_deflate(plist, 4), "compress " + name);
   }
-  Handle set(
+  return Handle(
       H5Dcreate2(parent, name.c_str(), file_type < 0 ? mem_type : file_type, space, H5P_DEFAULT, plist, H5P_DEFAULT),
       H5Dclose, "create dataset " + name);
+}
+
+template <typename T>
+void dataset(hid_t parent, const std::string& name, hid_t mem_type, const T* data, std::vector<hsize_t> dims,
+             hid_t file_type = -1) {
+  Handle set = create_dataset(parent, name, mem_type, dims, file_type);
+  std::size_t count = 1;
+  for (hsize_t d : dims) count *= d;
   if (count > 0) check(H5Dwrite(set, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data), "write " + name);
 }
+
+// Writes rows [first, first + rows) of a 2-D dataset of `columns` columns.
+void write_rows(hid_t set, hid_t mem_type, const void* data, hsize_t first, hsize_t rows, hsize_t columns,
+                const std::string& name) {
+  if (rows == 0) return;
+  Handle file_space(H5Dget_space(set), H5Sclose, "space of " + name);
+  const hsize_t start[2] = {first, 0}, count[2] = {rows, columns};
+  check(H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start, nullptr, count, nullptr), "select rows of " + name);
+  Handle mem_space(H5Screate_simple(2, count, nullptr), H5Sclose, "create space");
+  check(H5Dwrite(set, mem_type, mem_space, file_space, H5P_DEFAULT, data), "write " + name);
+}
+
+// The final mesh, written as the terrain hands it over: no copy of the whole mesh is held.
+class MeshWriter final : public MeshSink {
+ public:
+  explicit MeshWriter(hid_t group) : group_(group) {}
+  void begin(std::size_t vertices, std::size_t triangles, std::size_t edges) override {
+    vertices_.emplace(create_dataset(group_, "vertices", H5T_NATIVE_DOUBLE, {vertices, 3}));
+    triangles_.emplace(create_dataset(group_, "triangles", H5T_NATIVE_UINT32, {triangles, 3}));
+    edges_.emplace(create_dataset(group_, "constrained_edges", H5T_NATIVE_UINT32, {edges, 2}));
+  }
+  void vertices(std::span<const Vec3> v) override {
+    // Vec3 is three packed doubles.
+    static_assert(sizeof(Vec3) == 3 * sizeof(double));
+    write_rows(*vertices_, H5T_NATIVE_DOUBLE, v.data(), vertices_done_, v.size(), 3, "vertices");
+    vertices_done_ += v.size();
+  }
+  void triangles(std::span<const std::array<std::uint32_t, 3>> t) override {
+    write_rows(*triangles_, H5T_NATIVE_UINT32, t.data(), triangles_done_, t.size(), 3, "triangles");
+    triangles_done_ += t.size();
+  }
+  void constrained_edges(std::span<const std::array<std::uint32_t, 2>> e) override {
+    write_rows(*edges_, H5T_NATIVE_UINT32, e.data(), edges_done_, e.size(), 2, "constrained_edges");
+    edges_done_ += e.size();
+  }
+
+ private:
+  hid_t group_;
+  std::optional<Handle> vertices_, triangles_, edges_;
+  hsize_t vertices_done_ = 0, triangles_done_ = 0, edges_done_ = 0;
+};
 
 void raster_dataset(hid_t parent, const std::string& name, const Raster& r) {
   dataset(parent, name, H5T_NATIVE_DOUBLE, r.values.data(), {r.ny, r.nx});
@@ -166,6 +221,8 @@ void write_contents(hid_t file, const RunResult& run, const PreparedScene& p, co
   string_attribute(file, "backend", run.backend);
   string_attribute(file, "label", run.label);
   string_attribute(file, "version", kVersion);
+  string_attribute(file, "commit", kCommit);
+  string_attribute(file, "build_id", kBuildId);
   string_attribute(file, "compiler", std::string(kCompiler) + " " + kBuildType);
   string_attribute(file, "date", utc_now());
   string_attribute(file, "summary", summary.dump());
@@ -211,15 +268,8 @@ void write_contents(hid_t file, const RunResult& run, const PreparedScene& p, co
   Handle final_group = group(file, "final");
   raster_dataset(final_group, "raster", run.final_raster);
   Handle mesh = group(final_group, "mesh");
-  const SurfaceMesh& m = run.final_mesh;
-  std::vector<double> xyz;
-  xyz.reserve(m.vertices.size() * 3);
-  for (const Vec3& v : m.vertices) xyz.insert(xyz.end(), {v.x(), v.y(), v.z()});
-  dataset(mesh, "vertices", H5T_NATIVE_DOUBLE, xyz.data(), {m.vertices.size(), 3});
-  dataset(mesh, "triangles", H5T_NATIVE_UINT32, m.triangles.empty() ? nullptr : m.triangles.data()->data(),
-          {m.triangles.size(), 3});
-  dataset(mesh, "constrained_edges", H5T_NATIVE_UINT32,
-          m.constrained_edges.empty() ? nullptr : m.constrained_edges.data()->data(), {m.constrained_edges.size(), 2});
+  MeshWriter writer(mesh);
+  run.stream_final_mesh(writer);
 }
 
 // Reading.

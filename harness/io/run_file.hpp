@@ -2,7 +2,8 @@
 // HDF5 run files (contract: README "Run files (HDF5)"): one file per back-end run, written under a temporary
 // name and renamed when whole.
 //   /                   attributes: scene_text, scene_resolved, scene_path, overrides,
-//                       backend, label, parameters, version, compiler, date, summary (JSON)
+//                       backend, label, parameters, version, commit, build_id (the binary;
+//                       see version.hpp), compiler, date, summary (JSON)
 //   /steps/<field>      one row per step (StepRecord fields; stamp = -1 for relaxation)
 //   /summary            one attribute per metric (contract names)
 //   /initial/raster, /final/raster

@@ -2,6 +2,7 @@
 
 #include "common/input_error.hpp"
 #include "grid/grid_terrain.hpp"
+#include "grid/sparse_terrain.hpp"
 #include "tin/tin_terrain.hpp"
 
 namespace sb {
@@ -10,6 +11,7 @@ namespace {
 constexpr Backend kBackends[] = {
     {"tin", tin::make_tin_terrain},
     {"grid", grid::make_grid_terrain},
+    {"sparse", grid::make_sparse_terrain},
 };
 }  // namespace
 

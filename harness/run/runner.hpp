@@ -1,8 +1,12 @@
 #pragma once
 // The runner: applies one StampSchedule to one back-end, step by step (stamp, erode,
-// simplify), timing each phase and recording counts and volume after every step. Volume is
-// measured between phases and outside the timers, so each phase's volume change is known.
+// simplify), timing each phase and recording counts and volume after every step. Each
+// phase's volume change comes from the back-end's own report (O(1); a full volume(),
+// outside the timers, only for back-ends that do not track it); volume() runs at the start
+// and the end, where the tracked total is checked against it (volume_tracking_error).
+// The final mesh is not copied: the run keeps the terrain, and writers stream its mesh.
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -27,12 +31,13 @@ struct PreparedScene {
 PreparedScene prepare_scene(Scene scene);
 
 struct RunResult {
-  std::string backend;            // "tin", "grid"
+  std::string backend;            // "tin", "grid", "sparse"
   std::string label;              // backend plus variant overrides, e.g. "grid:grid.storage=float"
   std::vector<StepRecord> steps;  // stroke steps, then relaxation steps (stamp = -1)
   double volume_initial = 0.0;
   double volume_final = 0.0;
   double volume_added = 0.0;
+  double volume_tracking_error = 0.0;  // tracked total minus volume() at the end, m^3
   double max_slope_deg = 0.0;
   bool settled = false;  // erosion active set empty at the end
   // What a researcher should know about this run (summary "warnings", printed on stderr):
@@ -42,7 +47,16 @@ struct RunResult {
   std::size_t memory_bytes_peak = 0;
   Raster initial_raster;
   Raster final_raster;
-  SurfaceMesh final_mesh;
+  SurfaceMesh final_mesh;                        // set by callers that have no terrain
+  std::shared_ptr<const Terrain> final_terrain;  // the run's terrain (run_variant sets it)
+  // The final surface, streamed: from final_terrain when set, else final_mesh.
+  void stream_final_mesh(MeshSink& sink) const {
+    if (final_terrain)
+      final_terrain->stream_mesh(sink);
+    else
+      stream_mesh(final_mesh, sink);
+  }
+  SurfaceMesh final_surface() const { return final_terrain ? final_terrain->mesh() : final_mesh; }
 };
 
 // Progress callback: (done, total) stamps. Called at most every few hundred milliseconds.

@@ -67,6 +67,7 @@ Json summarize(const RunResult& run, const PreparedScene& p) {
   j["time_s.remove"] = remove;
   j["time_s.relax"] = relax;
   j["relax_steps"] = relax_steps;
+  j["volume_tracking_error"] = run.volume_tracking_error;
   j["volume_delta_tool"] = d_tool;
   j["volume_delta_erosion"] = d_erosion;
   j["volume_delta_simplify"] = d_simplify;

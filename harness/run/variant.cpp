@@ -66,7 +66,7 @@ VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_pr
   }
   PreparedScene prepared = base;
   prepared.scene = scene;
-  prepared.rule = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg);
+  prepared.rule = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg, scene.erosion.rule);
 
   auto terrain = make_terrain(v.backend, prepared.scene, prepared.initial);
   RunCallbacks callbacks;
@@ -81,6 +81,7 @@ VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_pr
   out.run.label = v.label;
   for (const std::string& w : out.run.warnings)
     std::fprintf(stderr, "sandbench: warning: [%s] %s\n", v.label.c_str(), w.c_str());
+  out.run.final_terrain = std::move(terrain);
   out.summary = summarize(out.run, prepared);
   return out;
 }

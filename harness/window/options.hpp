@@ -7,7 +7,7 @@ namespace sb {
 
 struct InteractiveOptions {
   std::string scene;
-  std::string backend;                 // tin | grid, optionally grid:key=value:...
+  std::string backend;                 // tin | grid | sparse, optionally grid:key=value:...
   std::string device = "mouse";        // mouse | replay:FILE | udp:PORT
   std::vector<std::string> overrides;  // --set
   std::string record;                  // session file; recording starts at once

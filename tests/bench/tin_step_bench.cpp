@@ -76,7 +76,7 @@ std::unique_ptr<Setup> build(std::int64_t n, bool conserve, bool border) {
                            "conserve_volume = " + (conserve ? "true" : "false") + "\n";
   s->scene = sb::parse_scene(text, "tin_step_bench");
   s->centre = sb::Vec2(size / 2, size / 2);
-  s->rule = sb::ErosionRule::from(s->scene.material, s->scene.erosion.settle_tolerance_deg);
+  s->rule = sb::ErosionRule::from(s->scene.material, s->scene.erosion.settle_tolerance_deg, s->scene.erosion.rule);
   std::vector<sb::Vec3> points;
   points.reserve(static_cast<std::size_t>(side * side));
   const std::int64_t mid = side / 2;

@@ -32,7 +32,7 @@ double unit(const std::uint8_t* p) {  // two bytes -> [0, 1]
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   static const sb::PreparedScene prepared = sb::prepare_scene(sb::parse_scene(kScene, "fuzz"));
   constexpr std::size_t kStampBytes = 8;
-  for (const char* backend : {"tin", "grid"}) {
+  for (const char* backend : {"tin", "grid", "sparse"}) {
     auto terrain = sb::make_terrain(backend, prepared.scene, prepared.initial);
     sb::Vec2 previous(0.1, 0.1);
     for (std::size_t i = 0; i + kStampBytes <= size && i < 64 * kStampBytes; i += kStampBytes) {

@@ -5,6 +5,7 @@
 // so a change to a golden is a reviewable diff.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -35,9 +36,11 @@ const std::vector<Case>& cases() {
       {"flat_stroke-tin", "flat_stroke.toml", "tin", {}},
       {"flat_stroke-grid", "flat_stroke.toml", "grid", {}},
       {"flat_stroke-grid-float", "flat_stroke.toml", "grid", {"grid.storage=float"}},
+      {"flat_stroke-sparse", "flat_stroke.toml", "sparse", {}},
       {"pile-tin", "pile.toml", "tin", {}},
       {"pile-grid", "pile.toml", "grid", {}},
       {"pile-grid-4", "pile.toml", "grid", {"grid.neighbours=4"}},
+      {"pile-sparse", "pile.toml", "sparse", {}},
       {"dunes-tin", "dunes.toml", "tin", {}},
       {"dunes-grid", "dunes.toml", "grid", {}},
   };
@@ -109,9 +112,19 @@ TEST_P(Regression, MetricsWithinGoldenBounds) {
   std::ifstream in(golden_path(c));
   ASSERT_TRUE(in) << "no golden " << golden_path(c) << "; run `make goldens`";
   const auto golden = nlohmann::json::parse(in);
-  // Whatever the golden says, a pile must stand at the critical angle (issue: within 2 degrees).
+  // Whatever the golden says, a pile must stand at the critical angle: within 2 degrees on the
+  // TIN and the 8-neighbour grids. A 4-neighbour stencil only sees slopes along the axes, so
+  // its edge rule admits flanks from 30 degrees up to atan(sqrt(2) tan 30) = 39.2 degrees
+  // (diagonal directions); where in that range the pile ends depends on the visit order.
   if (summary.contains("pile.flank_angle_deg")) {
-    EXPECT_NEAR(summary["pile.flank_angle_deg"].get<double>(), 30.0, 2.0) << c.name;
+    const double flank = summary["pile.flank_angle_deg"].get<double>();
+    const bool four = std::find(c.overrides.begin(), c.overrides.end(), "grid.neighbours=4") != c.overrides.end();
+    if (four) {
+      EXPECT_GE(flank, 28.0) << c.name;
+      EXPECT_LE(flank, 39.3) << c.name;
+    } else {
+      EXPECT_NEAR(flank, 30.0, 2.0) << c.name;
+    }
   }
   for (const auto& [metric, bound] : golden.at("metrics").items()) {
     ASSERT_TRUE(summary.contains(metric)) << metric;

@@ -61,7 +61,7 @@ struct Runner {
   explicit Runner(const Scene& s)
       : scene(s),
         terrain(make_tin_terrain(s, HeightField::from_scene(s))),
-        rule(ErosionRule::from(s.material, s.erosion.settle_tolerance_deg)) {}
+        rule(ErosionRule::from(s.material, s.erosion.settle_tolerance_deg, s.erosion.rule)) {}
 
   // One step with check() after each phase; returns false (after reporting) on a problem.
   bool step(ToolStamp st) {

@@ -2,17 +2,47 @@
 
 #include <array>
 #include <cmath>
+#include <numbers>
+#include <vector>
 
 #include "common/erosion.hpp"
 
 namespace sb {
 namespace {
 
-ErosionRule rule30(double fraction = 0.5) {
+ErosionRule rule30(double fraction = 0.5, ErosionRuleKind kind = ErosionRuleKind::Gradient, double settle_deg = 0.0) {
   Material m;
   m.critical_angle_deg = 30.0;
   m.transfer_fraction = fraction;
-  return ErosionRule::from(m, 0.0);
+  return ErosionRule::from(m, settle_deg, kind);
+}
+
+// The ring of neighbours of the origin on z = slope * (-u . p), u the downhill direction at
+// `azimuth_deg`: 8 grid neighbours (spacing h), or an irregular counter-clockwise ring.
+std::vector<ErosionNeighbour> plane_ring(double slope, double azimuth_deg, bool irregular) {
+  const double a = azimuth_deg * std::numbers::pi / 180.0;
+  const double ux = std::cos(a), uy = std::sin(a);
+  const double h = 0.0025;
+  std::vector<ErosionNeighbour> ring;
+  const int count = irregular ? 7 : 8;
+  for (int k = 0; k < count; ++k) {
+    double angle = 2.0 * std::numbers::pi * k / count, r = h;
+    if (irregular) {
+      angle += 0.35 * std::sin(3.1 * k);
+      r *= 1.0 + 0.4 * std::cos(1.7 * k);
+    } else if (k % 2 == 1) {
+      r *= std::sqrt(2.0);
+    }
+    const double dx = r * std::cos(angle), dy = r * std::sin(angle);
+    ring.push_back({-slope * (ux * dx + uy * dy), r, h * h, dx, dy});
+  }
+  return ring;
+}
+
+double transfers_on_plane(double slope_deg, double azimuth_deg, bool irregular, const ErosionRule& rule) {
+  const auto ring = plane_ring(std::tan(deg_to_rad(slope_deg)), azimuth_deg, irregular);
+  std::vector<double> out(ring.size());
+  return erosion_transfers(0.0, 0.0025 * 0.0025, fan_gradient(0.0, ring), ring, rule, out);
 }
 
 TEST(ErosionRule, NothingMovesBelowTheCriticalSlope) {
@@ -20,17 +50,17 @@ TEST(ErosionRule, NothingMovesBelowTheCriticalSlope) {
   const double just_below = d * std::tan(deg_to_rad(29.9));
   std::array<ErosionNeighbour, 2> n{{{0.0, d, 1e-4}, {0.0, d, 1e-4}}};
   std::array<double, 2> out{};
-  EXPECT_EQ(erosion_transfers(just_below, 1e-4, n, rule30(), out), 0.0);
+  EXPECT_EQ(erosion_transfers(just_below, 1e-4, {}, n, rule30(), out), 0.0);
   EXPECT_EQ(out[0], 0.0);
   const double just_above = d * std::tan(deg_to_rad(30.1));
-  EXPECT_GT(erosion_transfers(just_above, 1e-4, n, rule30(), out), 0.0);
+  EXPECT_GT(erosion_transfers(just_above, 1e-4, {}, n, rule30(), out), 0.0);
 }
 
 TEST(ErosionRule, TransfersConserveVolumeWithUnequalAreas) {
   const double zi = 0.05, ai = 3e-5;
   std::array<ErosionNeighbour, 3> n{{{0.0, 0.01, 1e-5}, {0.02, 0.012, 4e-5}, {0.06, 0.01, 2e-5}}};
   std::array<double, 3> out{};
-  const double total = erosion_transfers(zi, ai, n, rule30(), out);
+  const double total = erosion_transfers(zi, ai, {}, n, rule30(), out);
   ASSERT_GT(total, 0.0);
   EXPECT_EQ(out[2], 0.0);  // higher neighbour receives nothing
   // Height changes A_i dz_i + sum A_j dz_j = 0.
@@ -46,7 +76,7 @@ TEST(ErosionRule, SplitInProportionToExcessAndNeverOvershootsTheSteepestPair) {
   std::array<ErosionNeighbour, 2> n{{{0.0, d, a}, {0.004, d, a}}};
   std::array<double, 2> out{};
   const double zi = 0.02;
-  const double total = erosion_transfers(zi, a, n, rule30(1.0), out);
+  const double total = erosion_transfers(zi, a, {}, n, rule30(1.0), out);
   const double e0 = (zi - 0.0 - d * t) * a / 2, e1 = (zi - 0.004 - d * t) * a / 2;
   EXPECT_NEAR(out[0] / out[1], e0 / e1, 1e-12);
   EXPECT_NEAR(total, e0, 1e-18);  // fraction 1 of the largest pair excess
@@ -63,7 +93,72 @@ TEST(ErosionRule, SettleToleranceWidensTheStableBand) {
   const double d = 0.01;
   std::array<ErosionNeighbour, 1> n{{{0.0, d, 1e-4}}};
   std::array<double, 1> out{};
-  EXPECT_EQ(erosion_transfers(d * std::tan(deg_to_rad(30.3)), 1e-4, n, r, out), 0.0);
+  EXPECT_EQ(erosion_transfers(d * std::tan(deg_to_rad(30.3)), 1e-4, {}, n, r, out), 0.0);
+}
+
+TEST(ErosionRule, FanGradientIsExactOnPlanesAndIgnoresTheBorderGap) {
+  for (bool irregular : {false, true})
+    for (double az : {0.0, 22.5, 45.0, 101.0, 250.0}) {
+      const auto ring = plane_ring(0.7, az, irregular);
+      const SurfaceGradient g = fan_gradient(0.0, ring);
+      const double a = az * std::numbers::pi / 180.0;
+      EXPECT_NEAR(g.x, -0.7 * std::cos(a), 1e-12) << az;
+      EXPECT_NEAR(g.y, -0.7 * std::sin(a), 1e-12) << az;
+    }
+  // A border vertex: neighbours over a half-turn only; the pair across the outside (180
+  // degrees) is no facet.
+  std::vector<ErosionNeighbour> half{{0.1, 1.0, 1.0, 1.0, 0.0}, {0.2, 1.0, 1.0, 0.0, 1.0}, {-0.1, 1.0, 1.0, -1.0, 0.0}};
+  const SurfaceGradient g = fan_gradient(0.0, half);
+  EXPECT_NEAR(g.x, 0.1, 1e-15);
+  EXPECT_NEAR(g.y, 0.2, 1e-15);
+  EXPECT_EQ(fan_gradient(0.0, std::span(half).first(1)).x, 0.0);
+}
+
+// The gradient rule's promise: a plane at the critical angle rests in every azimuth, a
+// steeper one does not; the edge rule lets planes between neighbour directions stand steeper.
+TEST(ErosionRule, GradientRuleRestsPlanesAtTheCriticalAngleInEveryAzimuth) {
+  const ErosionRule gradient = rule30(0.5, ErosionRuleKind::Gradient, 0.1);
+  const ErosionRule edge = rule30(0.5, ErosionRuleKind::Edge, 0.1);
+  for (bool irregular : {false, true})
+    for (double az = 0.0; az < 360.0; az += 7.5) {
+      EXPECT_EQ(transfers_on_plane(30.0, az, irregular, gradient), 0.0) << az;
+      EXPECT_EQ(transfers_on_plane(29.0, az, irregular, gradient), 0.0) << az;
+      EXPECT_GT(transfers_on_plane(30.3, az, irregular, gradient), 0.0) << az;
+    }
+  // 22.5 degrees off the grid's directions: the edge rule holds 31.5 degrees, the gradient
+  // rule does not.
+  EXPECT_EQ(transfers_on_plane(31.5, 22.5, false, edge), 0.0);
+  EXPECT_GT(transfers_on_plane(31.5, 22.5, false, gradient), 0.0);
+  EXPECT_GT(transfers_on_plane(30.3, 0.0, false, edge), 0.0);
+}
+
+TEST(ErosionRule, GradientRuleSendsOnlyDownhillAndConservesVolume) {
+  const ErosionRule rule = rule30(1.0);
+  for (double az : {0.0, 22.5, 67.0, 200.0}) {
+    const auto ring = plane_ring(std::tan(deg_to_rad(40.0)), az, true);
+    std::vector<double> out(ring.size());
+    const double total = erosion_transfers(0.0, 1e-5, fan_gradient(0.0, ring), ring, rule, out);
+    ASSERT_GT(total, 0.0);
+    double sum = 0.0;
+    for (std::size_t k = 0; k < ring.size(); ++k) {
+      if (out[k] > 0.0) {
+        EXPECT_LT(ring[k].z, 0.0) << "sand sent uphill at azimuth " << az;
+      }
+      EXPECT_GE(out[k], 0.0);
+      sum += out[k];
+    }
+    EXPECT_NEAR(sum, total, 1e-15 * total);
+  }
+}
+
+TEST(ErosionRule, EdgeRuleIgnoresTheGradient) {
+  const ErosionRule edge = rule30(0.5, ErosionRuleKind::Edge);
+  const double d = 0.01;
+  std::array<ErosionNeighbour, 1> n{{{0.0, d, 1e-4, d, 0.0}}};
+  std::array<double, 1> out{};
+  EXPECT_EQ(erosion_transfers(d * std::tan(deg_to_rad(29.9)), 1e-4, {-5.0, 0.0}, n, edge, out), 0.0);
+  EXPECT_FALSE(edge.needs_gradient());
+  EXPECT_TRUE(rule30().needs_gradient());
 }
 
 }  // namespace

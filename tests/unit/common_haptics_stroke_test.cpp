@@ -53,7 +53,7 @@ StrokeRun replay_stroke(const PreparedScene& prepared, const Trajectory& stroke,
     patch_centre = centre;
   };
   republish(patch_centre);
-  const ErosionRule rule = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg);
+  const ErosionRule rule = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg, scene.erosion.rule);
   ServoCore core(device, patches, 40.0, rendering, kDt);
   core.start();
 

@@ -53,14 +53,17 @@ TYPED_TEST(GridErosion, FullRelaxationEndsAtTheCriticalAngle) {
 }
 
 TYPED_TEST(GridErosion, TouchesOnlyTheActiveSet) {
-  // A plane steeper than the angle of repose everywhere: eroding the whole grid would
-  // change every node; eroding the active set changes only what spreads from the stamp.
+  // A plane below the angle of repose (16.7 degrees) with a trench cut into it: the
+  // trench's walls collapse, and nothing far from them is read as changed or kept active.
+  // (Sweeps are live -- a run of unstable nodes ahead of the cursor moves in the same pass
+  // -- so a pass is not limited to one ring; on a plane steeper than the angle of repose
+  // the whole plane would rightly slide.)
   const Scene s = scene();
-  const auto plane = [](const Vec2& p) { return 0.1 + 0.8 * p.x(); };  // 38.7 degrees
+  const auto plane = [](const Vec2& p) { return 0.1 + 0.3 * p.x(); };
   const auto t = make_grid<TypeParam>(s, plane);
-  ASSERT_GT(t->max_slope_deg(), 35.0);
+  ASSERT_LT(t->max_slope_deg(), 25.0);
   const std::vector<TypeParam> before = t->heights().heights();
-  const ToolStamp st = stamp_at(s, {0.06, 0.06}, plane({0.06, 0.06}) - 0.01);
+  const ToolStamp st = stamp_at(s, {0.12, 0.12}, plane({0.12, 0.12}) - 0.01);
   t->stamp(st);
   const int passes = 10;
   const ErosionReport r = t->erode(rule_of(s), {.max_passes = passes});
@@ -68,10 +71,9 @@ TYPED_TEST(GridErosion, TouchesOnlyTheActiveSet) {
   EXPECT_GT(r.transfers, 0u);
   SB_EXPECT_CHECK_OK(*t);
 
-  // The stamp activates one ring of nodes around those it changed; each pass changes at
-  // most the neighbours of active nodes and activates one ring further.
+  // A 1 cm wall at 30 degrees reaches 1.7 cm beyond it; 4 cm is generous, the grid is 50 cm.
   const GridLayout& g = t->layout();
-  const Aabb2 reach = st.influence_bounds().expanded((passes + 2) * std::max(g.dx, g.dy) + 1e-9);
+  const Aabb2 reach = st.influence_bounds().expanded(0.04);
   std::size_t changed_outside_stamp = 0;
   for (std::size_t iy = 0; iy < g.ny; ++iy)
     for (std::size_t ix = 0; ix < g.nx; ++ix) {
@@ -84,8 +86,6 @@ TYPED_TEST(GridErosion, TouchesOnlyTheActiveSet) {
       if (!st.influence_bounds().contains(p) && t->heights().heights()[k] != before[k]) ++changed_outside_stamp;
     }
   EXPECT_GT(changed_outside_stamp, 0u);  // erosion did spread beyond the stamp
-  // The far corner in particular.
-  EXPECT_TRUE(same_bits(t->heights().heights()[g.index(g.nx - 1, g.ny - 1)], before[g.index(g.nx - 1, g.ny - 1)]));
 }
 
 TYPED_TEST(GridErosion, ConservesVolumeAndMovesMaterialDownhill) {

@@ -54,7 +54,9 @@ std::unique_ptr<GridTerrain<Real>> make_grid(const Scene& s) {
   return make_grid<Real>(s, [&field](const Vec2& p) { return field(p); });
 }
 
-inline ErosionRule rule_of(const Scene& s) { return ErosionRule::from(s.material, s.erosion.settle_tolerance_deg); }
+inline ErosionRule rule_of(const Scene& s) {
+  return ErosionRule::from(s.material, s.erosion.settle_tolerance_deg, s.erosion.rule);
+}
 
 inline StampSchedule schedule_of(const Scene& s) {
   const HeightField field = HeightField::from_scene(s);

@@ -1,5 +1,6 @@
 // Volume drift of the grid over a long stroke with erosion, per storage type.
 #include <cstdio>
+#include <span>
 
 #include "grid_test_support.hpp"
 
@@ -81,6 +82,75 @@ TEST(GridVolume, FloatDriftAfter1000StampsWithErosion) {
   // their rounding error on (grid/height_grid.hpp); without that the drift is 8.4e-8.
   EXPECT_LE(std::abs(d.relative), 1e-15);
   EXPECT_LE(std::abs(d.carry_relative), 1e-15);
+}
+
+// The volume changes the grid reports per phase add up to what volume() measures: the
+// runner's bookkeeping (volume() only at the start and the end) stands on this.
+template <class Real>
+class GridVolumeTracking : public ::testing::Test {};
+TYPED_TEST_SUITE(GridVolumeTracking, StorageTypes, StorageName);
+
+TYPED_TEST(GridVolumeTracking, ReportedChangesMatchTheIntegral) {
+  const Scene s = scene({"terrain.kind=\"dunes\""});
+  const auto t = make_grid<TypeParam>(s);
+  const ErosionRule rule = rule_of(s);
+  const double v0 = t->volume();
+  double tracked = v0;
+  ToolSpec pour;
+  pour.shape = ToolShape::Pour;
+  pour.radius_m = 0.02;
+  pour.pour_volume_m3 = 1e-5;
+  ToolPose at;
+  at.xy = {0.3, 0.3};
+  const StampReport poured = t->stamp(make_stamp(pour, at, Vec2::Zero(), 0));
+  ASSERT_FALSE(std::isnan(poured.volume_change_m3));
+  EXPECT_NEAR(poured.volume_change_m3, 1e-5, 1e-5 * 1e-7);  // the pour spreads it in the storage type
+  tracked += poured.volume_change_m3;
+  for (const ToolStamp& st : schedule_of(s).stamps) {
+    const StampReport sr = t->stamp(st);
+    const ErosionReport er = t->erode(rule, {.max_passes = 4});
+    ASSERT_FALSE(std::isnan(sr.volume_change_m3));
+    ASSERT_FALSE(std::isnan(er.volume_change_m3));
+    tracked += sr.volume_change_m3 + er.volume_change_m3;
+    ASSERT_NEAR(tracked, t->volume(), kVolumeTolerance<TypeParam> * v0);
+  }
+  const ErosionReport settle = t->erode(rule, {.max_passes = 100000});
+  tracked += settle.volume_change_m3;
+  EXPECT_EQ(settle.active, 0u);
+  EXPECT_NEAR(tracked, t->volume(), kVolumeTolerance<TypeParam> * v0);
+  EXPECT_NEAR(tracked, v0 + 1e-5, 1e-7 * v0);
+}
+
+// The streamed mesh is the mesh, piece for piece.
+class CollectingSink final : public MeshSink {
+ public:
+  SurfaceMesh m;
+  std::size_t counts[3] = {0, 0, 0};
+  void begin(std::size_t v, std::size_t t, std::size_t e) override {
+    counts[0] = v;
+    counts[1] = t;
+    counts[2] = e;
+  }
+  void vertices(std::span<const Vec3> v) override { m.vertices.insert(m.vertices.end(), v.begin(), v.end()); }
+  void triangles(std::span<const std::array<std::uint32_t, 3>> t) override {
+    m.triangles.insert(m.triangles.end(), t.begin(), t.end());
+  }
+  void constrained_edges(std::span<const std::array<std::uint32_t, 2>> e) override {
+    m.constrained_edges.insert(m.constrained_edges.end(), e.begin(), e.end());
+  }
+};
+
+TEST(GridMesh, StreamedMeshEqualsMesh) {
+  const Scene s = scene({"terrain.kind=\"dunes\"", "grid.cell_m=0.013"});
+  const auto t = make_grid<double>(s);
+  CollectingSink sink;
+  t->stream_mesh(sink);
+  const SurfaceMesh whole = t->mesh();
+  EXPECT_EQ(sink.counts[0], whole.vertices.size());
+  EXPECT_EQ(sink.counts[1], whole.triangles.size());
+  EXPECT_EQ(sink.counts[2], 0u);
+  EXPECT_EQ(sink.m.vertices, whole.vertices);
+  EXPECT_EQ(sink.m.triangles, whole.triangles);
 }
 
 }  // namespace

@@ -19,7 +19,7 @@ namespace sb {
 namespace {
 
 // The TIN compensates retriangulation volume changes only when asked (tin.conserve_volume);
-// the grid's bookkeeping is exact by construction.
+// the grids' bookkeeping is exact by construction.
 struct Tin {
   static constexpr const char* kName = "tin";
   static std::vector<std::string> overrides() { return {"tin.conserve_volume=true"}; }
@@ -27,6 +27,11 @@ struct Tin {
 };
 struct Grid {
   static constexpr const char* kName = "grid";
+  static std::vector<std::string> overrides() { return {}; }
+  static constexpr double kVolumeTolerance = 1e-12;
+};
+struct Sparse {
+  static constexpr const char* kName = "sparse";
   static std::vector<std::string> overrides() { return {}; }
   static constexpr double kVolumeTolerance = 1e-12;
 };
@@ -112,7 +117,9 @@ class TerrainTyped : public ::testing::Test {
     const HeightField field = HeightField::from_scene(s);
     return make_schedule(s.tool, s.stroke, [field](const Vec2& p) { return field(p); });
   }
-  static ErosionRule rule(const Scene& s) { return ErosionRule::from(s.material, s.erosion.settle_tolerance_deg); }
+  static ErosionRule rule(const Scene& s) {
+    return ErosionRule::from(s.material, s.erosion.settle_tolerance_deg, s.erosion.rule);
+  }
   static void expect_ok(const Terrain& t, const char* when) {
     const IntegrityReport r = t.check();
     EXPECT_TRUE(r.ok()) << when << ": " << ::testing::PrintToString(r.problems);
@@ -134,7 +141,7 @@ struct BackendName {
     return T::kName;
   }
 };
-using Backends = ::testing::Types<Tin, Grid>;
+using Backends = ::testing::Types<Tin, Grid, Sparse>;
 TYPED_TEST_SUITE(TerrainTyped, Backends, BackendName);
 
 TYPED_TEST(TerrainTyped, VolumeIsKeptByEveryPhase) {

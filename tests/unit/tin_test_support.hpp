@@ -81,7 +81,9 @@ inline Scene scene(const char* text = kFlatScene, const std::vector<std::string>
 
 inline std::unique_ptr<Terrain> make(const Scene& s) { return make_tin_terrain(s, HeightField::from_scene(s)); }
 
-inline ErosionRule rule_of(const Scene& s) { return ErosionRule::from(s.material, s.erosion.settle_tolerance_deg); }
+inline ErosionRule rule_of(const Scene& s) {
+  return ErosionRule::from(s.material, s.erosion.settle_tolerance_deg, s.erosion.rule);
+}
 
 inline StampSchedule schedule_of(const Scene& s) {
   const HeightField field = HeightField::from_scene(s);

@@ -1,0 +1,179 @@
+#pragma once
+// The grid stamp (grid_stamp.hpp) as a template over the height storage, so that the dense
+// and the sparse grid share one implementation. Include only where it is instantiated.
+//
+// Store concept (HeightGrid<Real> is one):
+//   const GridLayout& layout() const;
+//   double z(std::uint32_t k) const;        // height of node k = iy * nx + ix
+//   void set(std::uint32_t k, double z);    // stores z, carrying the rounding error on
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "common/terrain.hpp"
+#include "grid/compensated_sum.hpp"
+#include "grid/grid_layout.hpp"
+
+namespace sb::grid {
+
+namespace stamp_detail {
+
+struct Cut {
+  std::uint32_t node;
+  double bottom_z;
+};
+struct Deposit {
+  std::uint32_t node;
+  double weight;
+};
+
+// Rim nodes for a stamp whose own rim band holds none: the band is widened by a growing
+// multiple of the cell diagonal and weighted by taper only (the directional factor may be
+// zero on the only side the domain leaves). Empty only when no node lies outside the
+// footprint at all.
+inline std::vector<Deposit> widened_rim(const GridLayout& layout, const ToolStamp& s) {
+  const Aabb2 footprint_box = bounds(s.footprint);
+  const Aabb2 grid_box = layout.box();
+  std::vector<Deposit> rim;
+  // 64 doublings outgrow any domain; the bound only guards against non-finite input.
+  double extra = layout.diagonal();
+  for (int round = 0; round < 64; ++round, extra *= 2.0) {
+    const double width = std::max(0.0, s.rim.width_m) + extra;
+    const Aabb2 window = footprint_box.expanded(width);
+    const NodeRange r = layout.nodes_in(window);
+    bool any_outside = false;
+    for (std::size_t iy = r.y0; !r.empty && iy <= r.y1; ++iy) {
+      for (std::size_t ix = r.x0; ix <= r.x1; ++ix) {
+        const Vec2 p = layout.position(ix, iy);
+        if (s.contains(p)) continue;
+        any_outside = true;
+        const double d = distance_to_boundary(s.footprint, p);
+        if (d < width) rim.push_back({layout.index(ix, iy), 1.0 - d / width});
+      }
+    }
+    if (!rim.empty()) return rim;
+    const bool covers_grid = window.contains(grid_box.lo) && window.contains(grid_box.hi);
+    if (covers_grid && !any_outside) return rim;
+  }
+  return rim;
+}
+
+// Two circles about the footprint's vertex centroid that classify most nodes of the window
+// without a polygon test: a node inside the inner circle is in the footprint; a node
+// beyond the outer one is outside it, and beyond the outer one plus the rim width it is
+// also past the rim band (its distance to the boundary is at least |p - c| - R). Margins of
+// a billionth keep nodes whose classification rounding could flip on the polygon tests.
+struct FootprintCircles {
+  Vec2 centre{0.0, 0.0};
+  double inner2 = -1.0;  // squared radii
+  double outer2 = 0.0;
+  double band2 = 0.0;
+
+  explicit FootprintCircles(const ToolStamp& s) {
+    for (const Vec2& v : s.footprint) centre += v;
+    centre /= static_cast<double>(s.footprint.size());
+    double outer = 0.0;
+    for (const Vec2& v : s.footprint) outer = std::max(outer, (v - centre).norm());
+    const double margin = 1e-9 * outer;
+    if (s.contains(centre)) {
+      const double inner = distance_to_boundary(s.footprint, centre) - margin;
+      if (inner > 0.0) inner2 = inner * inner;
+    }
+    outer += margin;
+    outer2 = outer * outer;
+    const double band = outer + std::max(0.0, s.rim.width_m) + margin;
+    band2 = band * band;
+  }
+};
+
+template <class Store>
+StampReport cut_and_push(Store& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed) {
+  const GridLayout& layout = grid.layout();
+  StampReport report;
+  if (s.footprint.size() < 3) return report;
+  const NodeRange r = layout.nodes_in(s.influence_bounds());
+  if (r.empty) return report;
+
+  const FootprintCircles circles(s);
+  std::vector<Cut> cuts;
+  std::vector<Deposit> rim;
+  for (std::size_t iy = r.y0; iy <= r.y1; ++iy) {
+    for (std::size_t ix = r.x0; ix <= r.x1; ++ix) {
+      const Vec2 p = layout.position(ix, iy);
+      const double d2 = (p - circles.centre).squaredNorm();
+      if (d2 >= circles.band2) continue;
+      const std::uint32_t k = layout.index(ix, iy);
+      if (d2 < circles.inner2 || (d2 <= circles.outer2 && s.contains(p))) {
+        const double bottom = s.bottom_z(p);
+        if (grid.z(k) > bottom) cuts.push_back({k, bottom});
+      } else if (const double w = s.rim_weight(p); w > 0.0) {
+        rim.push_back({k, w});
+      }
+    }
+  }
+  if (cuts.empty()) return report;
+  if (rim.empty()) rim = widened_rim(layout, s);
+  // No node outside the footprint (a tool larger than the domain): cutting would lose
+  // the volume, so the stamp does nothing.
+  if (rim.empty()) return report;
+
+  CompensatedSum removed, rim_weight;
+  for (const Cut& c : cuts) removed.add(layout.area(c.node) * (grid.z(c.node) - c.bottom_z));
+  for (const Deposit& d : rim) rim_weight.add(layout.area(d.node) * d.weight);
+  const double volume = removed.value();
+  const double per_weight = volume / rim_weight.value();
+
+  for (const Cut& c : cuts) {
+    grid.set(c.node, c.bottom_z);
+    changed.push_back(c.node);
+  }
+  CompensatedSum deposited;
+  for (const Deposit& d : rim) {
+    const double dz = per_weight * d.weight;
+    grid.set(d.node, grid.z(d.node) + dz);
+    deposited.add(layout.area(d.node) * dz);
+    changed.push_back(d.node);
+  }
+  report.volume_removed_m3 = volume;
+  report.volume_deposited_m3 = deposited.value();
+  report.elements_touched = cuts.size() + rim.size();
+  return report;
+}
+
+template <class Store>
+StampReport pour(Store& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed) {
+  const GridLayout& layout = grid.layout();
+  if (!s.pose.xy.allFinite() || !std::isfinite(s.pour_volume_m3)) return {};
+  std::vector<std::uint32_t> nodes;
+  const NodeRange r = layout.nodes_in(s.influence_bounds());
+  const double r2 = s.pour_radius_m * s.pour_radius_m;
+  for (std::size_t iy = r.y0; !r.empty && iy <= r.y1; ++iy)
+    for (std::size_t ix = r.x0; ix <= r.x1; ++ix)
+      if ((layout.position(ix, iy) - s.pose.xy).squaredNorm() <= r2) nodes.push_back(layout.index(ix, iy));
+  // A pour narrower than a cell (or off the grid) still lands somewhere.
+  if (nodes.empty()) nodes.push_back(layout.nearest(s.pose.xy));
+
+  CompensatedSum area;
+  for (std::uint32_t k : nodes) area.add(layout.area(k));
+  const double dz = s.pour_volume_m3 / area.value();
+  CompensatedSum deposited;
+  for (std::uint32_t k : nodes) {
+    grid.set(k, grid.z(k) + dz);
+    deposited.add(layout.area(k) * dz);
+    changed.push_back(k);
+  }
+  StampReport report;
+  report.volume_deposited_m3 = deposited.value();
+  report.elements_touched = nodes.size();
+  return report;
+}
+
+}  // namespace stamp_detail
+
+template <class Store>
+StampReport stamp_grid(Store& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed) {
+  return s.is_pour() ? stamp_detail::pour(grid, s, changed) : stamp_detail::cut_and_push(grid, s, changed);
+}
+
+}  // namespace sb::grid

@@ -1,0 +1,9 @@
+#pragma once
+// Live heap bytes of the test executable: counting_allocator.cpp replaces the global
+// operator new/delete of every executable it is linked into, so that a model's own account
+// of its containers (stats().bytes) can be checked against what it really holds.
+namespace sb::test {
+
+long long live_heap_bytes();
+
+}  // namespace sb::test
