@@ -8,7 +8,7 @@ from pathlib import Path
 
 # A table column or summary key that holds a wall-clock measurement (or a quantity fitted to
 # one), which differs from run to run: "tool s", "step ms p50", "time s", "time_s.total"...
-TIMING = re.compile(r"(^|[\s_.])(s|ms)($|[\s_.])|time|per_s", re.IGNORECASE)
+TIMING = re.compile(r"(^|[\s_.])(s|ms)($|[\s_.])|time|per_s|step p50|settling", re.IGNORECASE)
 # Tables measured in real time as a whole (the haptic replay: where the stamps fall depends on
 # how fast the simulation thread ran), compared by shape only: headers, rows, first column.
 REAL_TIME_TABLES = {"haptics.csv"}
