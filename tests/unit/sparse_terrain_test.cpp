@@ -124,7 +124,7 @@ cell_m = 0.005
   const PreparedScene prepared = prepare_scene(s);
   auto t = make_terrain("sparse", prepared.scene, prepared.initial);
   const auto& sparse = dynamic_cast<const SparseGridTerrain<double>&>(*t);
-  t->stamp(prepared.schedule.stamps.at(0));
+  t->stamp(prepared.schedule.stamps.front());
   const std::size_t leaves_after_stamp = sparse.heights().counts().leaves;
   EXPECT_EQ(sparse.heights().counts().tile_blocks, 0u);
   for (int i = 0; i < 1000 && t->erode(prepared.rule, {.max_passes = 64}).active > 0; ++i) {
