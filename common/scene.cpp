@@ -524,6 +524,7 @@ std::vector<SceneKey> scene_keys() {
       {},
       {"terrain.kind=dunes"},
       {"terrain.kind=heightmap", "terrain.path=\"terrain.png\""},
+      {"terrain.kind=plane"},
       {"tool.shape=box", "tool.size_m=[0.04, 0.02]"},
       {"tool.shape=ellipse", "tool.size_m=[0.04, 0.02]"},
       {"tool.shape=polygon", "tool.polygon_m=[[0,0],[0.01,0],[0,0.01]]"},

@@ -17,6 +17,8 @@ std::string scene_key_meaning(const std::string& key) {
       {"terrain.seed", "dunes: random seed"},
       {"terrain.path", "heightmap: 16-bit grey PNG stretched over the domain (relative to the scene file)"},
       {"terrain.vertical_scale_m", "heightmap: z = height_m + v/65535 * scale"},
+      {"terrain.slope_deg", "plane: slope; height_m at the domain's centre"},
+      {"terrain.azimuth_deg", "plane: downhill direction, counter-clockwise from +x"},
       {"material.critical_angle_deg", "angle of repose"},
       {"material.transfer_fraction", "fraction of a pair's excess moved per visit"},
       {"material.stiffness_n_per_m", "haptic force model: stiffness"},
@@ -27,6 +29,9 @@ std::string scene_key_meaning(const std::string& key) {
       {"erosion.settle_tolerance_deg", "slopes up to critical + this count as stable"},
       {"erosion.relax_at_end", "settle after the stroke (recorded as steps with stamp -1)"},
       {"erosion.relax_max_passes", "at most this many settling passes"},
+      {"erosion.rule",
+       "\"edge\": slopes along neighbour directions only (the paper's); \"gradient\": also along the downhill "
+       "gradient, so a surface rests at the critical angle in every azimuth"},
       {"tool.shape", "footprint"},
       {"tool.radius_m", "disk radius; pour radius"},
       {"tool.size_m", "box: full sizes; ellipse: axes (along and across the motion)"},
