@@ -10,10 +10,10 @@
 #include "common/atomic_file.hpp"
 #include "common/input_error.hpp"
 #include "harness/cli/commands.hpp"
+#include "harness/cli/scene_input.hpp"
 #include "harness/cli/validators.hpp"
 #include "harness/figures/compare_pictures.hpp"
 #include "harness/io/run_file.hpp"
-#include "harness/io/session_file.hpp"
 #include "harness/run/backends.hpp"
 #include "harness/run/variant.hpp"
 
@@ -88,20 +88,7 @@ void compare_command(const CompareOptions& o) {
   const std::filesystem::path dir = o.out;
   if (!dir.empty()) check_output_directory(dir, "--out", {o.scene, o.replay});  // --out '' fails its validator
 
-  // A replayed session's own overrides (its material) come first, so --set still wins.
-  Session session;
-  std::vector<std::string> overrides = scene_overrides(o.unset, o.overrides);
-  if (!o.replay.empty()) {
-    session = read_session(o.replay, "--replay");
-    if (session.stamps.empty()) throw InputError("--replay " + o.replay + ": the session has no stamps");
-    overrides.insert(overrides.begin(), session.overrides.begin(), session.overrides.end());
-  }
-  PreparedScene prepared = prepare_scene(load_scene(o.scene, overrides));
-  if (!o.replay.empty()) {
-    validate_session(session, prepared.scene, "--replay " + o.replay);
-    prepared.schedule = session_schedule(session);
-    prepared.scene.reference = ReferenceKind::None;  // the analytic references follow the scene's stroke
-  }
+  PreparedScene prepared = prepare_input(o.scene, o.unset, o.overrides, o.replay);
   // A folder being written holds this marker until its last picture is there, so a killed
   // compare leaves a folder that says it is incomplete.
   const std::filesystem::path marker = dir / "INCOMPLETE";

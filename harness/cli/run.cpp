@@ -5,9 +5,9 @@
 #include "common/atomic_file.hpp"
 #include "common/input_error.hpp"
 #include "harness/cli/commands.hpp"
+#include "harness/cli/scene_input.hpp"
 #include "harness/cli/validators.hpp"
 #include "harness/io/run_file.hpp"
-#include "harness/io/session_file.hpp"
 #include "harness/run/backends.hpp"
 #include "harness/run/variant.hpp"
 
@@ -25,20 +25,7 @@ struct RunOptions {
 };
 
 void run_command(const RunOptions& o) {
-  // A session's own overrides (its material) come first, so --set still wins.
-  Session session;
-  std::vector<std::string> overrides = scene_overrides(o.unset, o.overrides);
-  if (!o.replay.empty()) {
-    session = read_session(o.replay, "--replay");
-    if (session.stamps.empty()) throw InputError("--replay " + o.replay + ": the session has no stamps");
-    overrides.insert(overrides.begin(), session.overrides.begin(), session.overrides.end());
-  }
-  PreparedScene prepared = prepare_scene(load_scene(o.scene, overrides));
-  if (!o.replay.empty()) {
-    validate_session(session, prepared.scene, "--replay " + o.replay);
-    prepared.schedule = session_schedule(session);
-    prepared.scene.reference = ReferenceKind::None;  // the analytic references follow the scene's stroke
-  }
+  PreparedScene prepared = prepare_input(o.scene, o.unset, o.overrides, o.replay);
   const Variant variant = parse_variant(o.backend, "--backend");
   const std::filesystem::path out =
       o.out.empty() ? default_run_path(o.scene, variant.label) : std::filesystem::path(o.out);
