@@ -71,7 +71,8 @@ class GridTerrain final : public Terrain {
   double height(const Vec2& p) const override { return grid_.height(p); }
   StampReport stamp(const ToolStamp& s) override;
   ErosionReport erode(const ErosionRule& rule, const ErosionBudget& budget) override;
-  SimplifyReport simplify(const SimplifyParams&) override { return {}; }
+  // Nothing to simplify on a grid: the volume does not change.
+  SimplifyReport simplify(const SimplifyParams&) override { return {.volume_change_m3 = 0.0}; }
   double volume() const override { return grid_.volume(); }
   ModelStats stats() const override;
   SurfaceMesh mesh() const override;

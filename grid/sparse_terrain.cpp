@@ -16,7 +16,12 @@ SparseGridTerrain<Real>::SparseGridTerrain(const GridLayout& layout, const std::
 template <class Real>
 StampReport SparseGridTerrain<Real>::stamp(const ToolStamp& s) {
   std::vector<std::uint32_t> changed;
-  const StampReport report = stamp_grid(heights_, s, changed);
+  const double carry_before = heights_.carry_m3();
+  StampReport report = stamp_grid(heights_, s, changed);
+  // What the stored volume changed by, as on the dense grid: the stamp's own sums, less what
+  // rounding put into the carry (zero in double).
+  report.volume_change_m3 =
+      report.volume_deposited_m3 - report.volume_removed_m3 - (heights_.carry_m3() - carry_before);
   const GridLayout& layout = heights_.layout();
   for (std::uint32_t k : changed) {
     const auto [ix, iy] = layout.split(k);
@@ -30,7 +35,10 @@ ErosionReport SparseGridTerrain<Real>::erode(const ErosionRule& rule, const Eros
   const bool gradient = rule.needs_gradient();
   if (!tables_ || !tables_->built_for(rule, gradient))
     tables_.emplace(heights_.layout(), stencil_.size, rule, gradient);
-  const ErosionReport report = erode_ordered(heights_, active_, *tables_, budget);
+  const double carry_before = heights_.carry_m3();
+  ErosionReport report = erode_ordered(heights_, active_, *tables_, budget);
+  // Transfers conserve volume; only rounding into the carry changes the stored volume.
+  report.volume_change_m3 = carry_before - heights_.carry_m3();
   // Settled: blocks that came back to one height become tiles again.
   if (active_.empty()) heights_.prune();
   return report;

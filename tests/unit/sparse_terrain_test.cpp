@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -76,6 +77,30 @@ INSTANTIATE_TEST_SUITE_P(Shipped, SparseAgainstDense,
                          [](const ::testing::TestParamInfo<Case>& info) {
                            return std::string(info.param.scene) + (info.param.overrides.empty() ? "" : "_variant");
                          });
+
+// The sparse grid reports each phase's exact volume change (no NaN: the runner never falls
+// back to a full volume()), and the changes add up to what volume() measures.
+TEST(SparseGridTerrain, ReportedVolumeChangesMatchTheIntegral) {
+  for (const char* storage : {"\"double\"", "\"float\""}) {
+    const PreparedScene prepared = prepare_scene(shipped("flat_stroke", {std::string("grid.storage=") + storage}));
+    auto t = make_terrain("sparse", prepared.scene, prepared.initial);
+    const double v0 = t->volume();
+    double tracked = v0;
+    const double tolerance = (std::string(storage) == "\"float\"" ? 1e-12 : 1e-14) * v0;
+    for (const ToolStamp& st : prepared.schedule.stamps) {
+      const StampReport sr = t->stamp(st);
+      const ErosionReport er = t->erode(prepared.rule, {.max_passes = 4});
+      const SimplifyReport simp = t->simplify({});
+      ASSERT_FALSE(std::isnan(sr.volume_change_m3));
+      ASSERT_FALSE(std::isnan(er.volume_change_m3));
+      ASSERT_FALSE(std::isnan(simp.volume_change_m3));
+      tracked += sr.volume_change_m3 + er.volume_change_m3 + simp.volume_change_m3;
+    }
+    EXPECT_NEAR(tracked, t->volume(), tolerance) << storage;
+    const RunResult r = run_schedule(*make_terrain("sparse", prepared.scene, prepared.initial), prepared);
+    EXPECT_LE(std::abs(r.volume_tracking_error), tolerance) << storage;
+  }
+}
 
 TEST(SparseGridTerrain, StatsBytesMatchTheAllocator) {
   const PreparedScene prepared = prepare_scene(shipped("pile"));
