@@ -21,6 +21,7 @@
 // Memory: 1 bit per node and 4 bytes per row, plus the counts: 2 bytes per node (dense),
 // or bit_width(idle_passes - 1) bits per node (bit planes; 1 bit for the default 2).
 // activate_block / idle are O(1); a sweep is O(rows + words of rows with members + visits).
+#include <algorithm>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -45,6 +46,8 @@ class DenseIdleCounts {
   void reset(std::size_t y, std::size_t x0, std::size_t x1) {
     for (std::size_t x = x0; x <= x1; ++x) counts_[y * nx_ + x] = 0;
   }
+  // Every count back to 0.
+  void clear() { std::fill(counts_.begin(), counts_.end(), std::uint16_t{0}); }
   std::size_t bytes() const { return counts_.capacity() * sizeof(std::uint16_t); }
   // Counts below idle_passes, zero for non-members.
   void check(const std::vector<std::uint64_t>& bits, std::size_t words_per_row, std::uint16_t idle_passes,
@@ -84,6 +87,25 @@ class BasicActiveSet {
     --size_;
   }
 
+  // No member left (the dense erosion pass rebuilds the set as it goes). O(nodes / 64 + rows)
+  // plus the idle counts' clear.
+  void clear() {
+    std::fill(bits_.begin(), bits_.end(), std::uint64_t{0});
+    std::fill(row_count_.begin(), row_count_.end(), std::uint32_t{0});
+    idle_.clear();
+    size_ = 0;
+  }
+  // Every node a member with a fresh idle count (tests and benchmarks). O(nodes).
+  void activate_all() {
+    for (std::size_t iy = 0; iy < ny_; ++iy) {
+      set_bits(iy, 0, nx_ - 1);
+      idle_.reset(iy, 0, nx_ - 1);
+    }
+  }
+  // The number of the next sweep (it chooses the sweep's direction, see above), counted up.
+  // Shared by the active set's sweeps and the dense erosion pass (erosion_kernel.hpp).
+  unsigned next_sweep() { return sweeps_++; }
+
   // One ordered, live sweep (see above); direction from the pass number. Calls
   // visit(ix, iy), which returns true when the node transferred (the caller then activates
   // its block) -- the set marks idle nodes itself. Stops after max_visits visits; the
@@ -103,14 +125,20 @@ class BasicActiveSet {
   void check(std::vector<std::string>& problems) const;
 
  private:
+  // Set bits in a word (no popcnt instruction on baseline x86-64: std::popcount is a
+  // library call there; activate_block adds at most 3 bits per word).
+  static int bits_in(std::uint64_t w) {
+    int n = 0;
+    for (; w != 0; w &= w - 1) ++n;
+    return n;
+  }
   void set_bits(std::size_t y, std::size_t x0, std::size_t x1) {
-    // x1 - x0 <= 2: the bits span at most two words.
     std::uint64_t* row = bits_.data() + y * words_per_row_;
     for (std::size_t x = x0; x <= x1;) {
       const std::size_t wi = x / 64, lo = x % 64, hi = std::min<std::size_t>(63, lo + (x1 - x));
       const std::uint64_t mask =
           (hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & ~((std::uint64_t{1} << lo) - 1);
-      const int added = std::popcount(mask & ~row[wi]);
+      const int added = bits_in(mask & ~row[wi]);
       row[wi] |= mask;
       row_count_[y] += static_cast<std::uint32_t>(added);
       size_ += static_cast<std::size_t>(added);
@@ -130,7 +158,7 @@ class BasicActiveSet {
 template <class Idle>
 template <class Visit>
 std::size_t BasicActiveSet<Idle>::sweep(std::size_t max_visits, Visit&& visit) {
-  const unsigned pass = sweeps_++;
+  const unsigned pass = next_sweep();
   const bool y_up = pass % 2 == 0;
   const bool x_up = (pass / 2) % 2 == 0;
   std::size_t visits = 0;

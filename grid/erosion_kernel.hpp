@@ -49,7 +49,9 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 #include "common/erosion.hpp"
@@ -173,15 +175,144 @@ inline VisitResult erosion_visit(Store& store, const ErosionTables& t, std::size
   return r;
 }
 
-// Ordered, live sweeps over `active` until it is empty or the budget is spent (see
-// active_set.hpp for the order). Cost: O(visits) plus the set's O(rows) per sweep.
+// Which sweep erode_ordered runs (tests force one; Auto is what the terrains use).
+enum class SweepPath { Auto, ActiveSet, Dense };
+
+// The active set's size from which a pass sweeps every node (dense_pass) instead of the
+// members: a dense pass costs ~1/8 of an active-set visit per node (measured,
+// tests/bench/grid_bench.cpp), so it wins once more than about an eighth of the nodes are
+// members.
+inline bool dense_pass_pays(std::size_t active, std::size_t nodes) { return active * 8 >= nodes; }
+
+// Two heights at p[0..1], widened to double (GCC/Clang vector extensions: one SSE2 register
+// on baseline x86-64; no intrinsics, no FMA, so each lane computes what the scalar code
+// does, bit for bit).
+using Double2 = double __attribute__((vector_size(16)));
+using Mask2 = std::int64_t __attribute__((vector_size(16)));
+template <class Real>
+inline Double2 load2(const Real* p) {
+  if constexpr (std::is_same_v<Real, double>) {
+    Double2 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  } else {
+    using Float2 = float __attribute__((vector_size(8)));
+    Float2 f;
+    std::memcpy(&f, p, sizeof f);
+    return __builtin_convertvector(f, Double2);
+  }
+}
+
+// Whether each interior node x in [1, nx - 2] of a row of contiguous heights `z` (node
+// (0, iy); rows iy - 1 and iy + 1 at -nx and +nx) may transfer: the first half of
+// erosion_visit with the same floating-point expressions, so a node it calls stable is one
+// the visit would leave alone. Two nodes at a time. Interior rows only (every neighbour
+// present: the thresholds are the interior class's).
+template <int N, bool Gradient, class Real>
+void unstable_flags(const Real* z, std::size_t nx, const NodeClass& c, double tan_settle2, std::int64_t* out) {
+  const auto w = static_cast<std::ptrdiff_t>(nx);
+  const auto flag = [&](std::ptrdiff_t x) {  // one node, scalar
+    const double zi = static_cast<double>(z[x]);
+    bool u = false;
+    for (int s = 0; s < N; ++s) u |= zi - static_cast<double>(z[x + c.offset[s]]) - c.crit[s] > c.margin[s];
+    if constexpr (Gradient) {
+      const double gx = (static_cast<double>(z[x + 1]) - static_cast<double>(z[x - 1])) * c.inv_run_x;
+      const double gy = (static_cast<double>(z[x + w]) - static_cast<double>(z[x - w])) * c.inv_run_y;
+      u |= gx * gx + gy * gy > tan_settle2;
+    }
+    return static_cast<std::int64_t>(u);
+  };
+  std::ptrdiff_t x = 1;
+  for (; x + 2 < w; x += 2) {
+    const Double2 zi = load2(z + x);
+    Mask2 u = {0, 0};
+#pragma GCC unroll 8
+    for (int s = 0; s < N; ++s) u |= zi - load2(z + x + c.offset[s]) - c.crit[s] > c.margin[s];
+    if constexpr (Gradient) {
+      const Double2 gx = (load2(z + x + 1) - load2(z + x - 1)) * c.inv_run_x;
+      const Double2 gy = (load2(z + x + w) - load2(z + x - w)) * c.inv_run_y;
+      u |= gx * gx + gy * gy > tan_settle2;
+    }
+    std::memcpy(out + x, &u, sizeof u);  // lanes are 0 or -1
+  }
+  for (; x + 1 < w; ++x) out[x] = flag(x);
+}
+
+// One dense pass: every node visited once, in place (Gauss-Seidel), in the direction the
+// active set's next sweep would take; the active set is rebuilt from the blocks of the nodes
+// that transferred (each a member with a fresh idle count). Same visits, same rule, same
+// conservation as the active-set sweep; what differs is which nodes are visited: every node,
+// members or not, once (an active-set sweep visits only members, and live ones again).
+//
+// Exactness of the shortcut. On a store with contiguous heights (HeightGrid: data()), the
+// row's nodes are first classed by unstable_flags, computed after the previous row is done;
+// a node is then visited only if it is flagged, on a border, or one of the two nodes before
+// it in the row transferred (a visit writes into its 3 x 3 block, which a node up to two
+// columns away reads). Its inputs are otherwise those it was classed with, so skipping it is
+// exactly what its visit would have done: the pass gives the same heights, bit for bit, as a
+// plain sweep of every node (which is what it runs on other stores, e.g. the sparse grid).
+//
+// Cost: O(nodes) per pass -- the classing vectorised over the row, one visit per unstable node
+// -- plus O(nodes / 64 + rows + counts) to clear the active set.
 template <int N, bool Gradient, class Store, class Active>
-ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t, const ErosionBudget& budget) {
+void dense_pass(Store& store, Active& active, const ErosionTables& t, ErosionReport& report, double& moved) {
+  const std::size_t nx = t.layout().nx, ny = t.layout().ny;
+  const unsigned pass = active.next_sweep();
+  const bool y_up = pass % 2 == 0;
+  const bool x_up = (pass / 2) % 2 == 0;
+  active.clear();
+  constexpr bool kContiguous = requires { store.data(); };
+  std::vector<std::int64_t> flags(kContiguous ? nx : 0, 1);  // as wide as a double: one vector lane each
+  const double tan_settle2 = t.tan_settle() * t.tan_settle();
+  for (std::size_t r = 0; r < ny; ++r) {
+    const std::size_t iy = y_up ? r : ny - 1 - r;
+    const bool interior_row = iy > 0 && iy + 1 < ny && nx >= 3;
+    const NodeClass& middle = t.of(nx / 2, iy);
+    if constexpr (kContiguous) {
+      if (interior_row) unstable_flags<N, Gradient>(store.data() + iy * nx, nx, middle, tan_settle2, flags.data());
+    }
+    int since_transfer = 3;  // nodes visited since the last one that transferred, in this row
+    for (std::size_t c = 0; c < nx; ++c) {
+      const std::size_t ix = x_up ? c : nx - 1 - c;
+      const bool edge = ix < 2 || ix + 2 >= nx;
+      if constexpr (kContiguous) {
+        if (interior_row && since_transfer > 2 && !flags[ix] && ix > 0 && ix + 1 < nx) {
+          ++since_transfer;
+          continue;
+        }
+      }
+      const VisitResult v = erosion_visit<N, Gradient>(store, t, iy * nx + ix, edge ? t.of(ix, iy) : middle);
+      if (v.transfers == 0) {
+        ++since_transfer;
+        continue;
+      }
+      since_transfer = 0;
+      report.transfers += static_cast<std::size_t>(v.transfers);
+      moved += v.moved;
+      active.activate_block(ix, iy);
+    }
+  }
+  report.updates += nx * ny;
+}
+
+// Passes until `active` is empty or the budget is spent: ordered, live sweeps of the active
+// set (see active_set.hpp for the order), or a dense pass (dense_pass) when most nodes are
+// members and the budget allows a whole pass. Cost: O(visits) plus the set's O(rows) per
+// active-set sweep, O(nodes) per dense pass.
+template <int N, bool Gradient, class Store, class Active>
+ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t, const ErosionBudget& budget,
+                            SweepPath path = SweepPath::Auto) {
   ErosionReport report;
-  const std::size_t nx = t.layout().nx;
+  const std::size_t nx = t.layout().nx, nodes = t.layout().nodes();
   double moved = 0.0;
   while (report.passes < budget.max_passes && !active.empty() && report.updates < budget.max_updates) {
     ++report.passes;
+    const bool dense = path == SweepPath::Dense || (path == SweepPath::Auto && dense_pass_pays(active.size(), nodes) &&
+                                                    budget.max_updates - report.updates >= nodes);
+    if (dense) {
+      dense_pass<N, Gradient>(store, active, t, report, moved);
+      continue;
+    }
     report.updates += active.sweep(budget.max_updates - report.updates, [&](std::size_t ix, std::size_t iy) {
       const VisitResult v = erosion_visit<N, Gradient>(store, t, iy * nx + ix, t.of(ix, iy));
       if (v.transfers == 0) return false;
@@ -198,12 +329,13 @@ ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t
 
 // Dispatches on the stencil size and the rule kind.
 template <class Store, class Active>
-ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t, const ErosionBudget& budget) {
+ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t, const ErosionBudget& budget,
+                            SweepPath path = SweepPath::Auto) {
   if (t.neighbours() == 4)
-    return t.gradient() ? erode_ordered<4, true>(store, active, t, budget)
-                        : erode_ordered<4, false>(store, active, t, budget);
-  return t.gradient() ? erode_ordered<8, true>(store, active, t, budget)
-                      : erode_ordered<8, false>(store, active, t, budget);
+    return t.gradient() ? erode_ordered<4, true>(store, active, t, budget, path)
+                        : erode_ordered<4, false>(store, active, t, budget, path);
+  return t.gradient() ? erode_ordered<8, true>(store, active, t, budget, path)
+                      : erode_ordered<8, false>(store, active, t, budget, path);
 }
 
 }  // namespace sb::grid

@@ -81,7 +81,10 @@ class GridTerrain final : public Terrain {
   IntegrityReport check() const override;
   double max_slope_deg() const override;
 
-  // For tests and benchmarks.
+  // For tests and benchmarks: every node a member of the active set; which sweep erosion
+  // runs (default Auto: the dense pass when at least an eighth of the nodes are members).
+  void activate_all() { active_.activate_all(); }
+  void set_sweep_path(SweepPath path) { sweep_path_ = path; }
   const GridLayout& layout() const { return grid_.layout(); }
   const HeightGrid<Real>& heights() const { return grid_; }
   const ActiveSet& active_set() const { return active_; }
@@ -91,6 +94,7 @@ class GridTerrain final : public Terrain {
   HeightGrid<Real> grid_;
   Stencil stencil_;
   ActiveSet active_;
+  SweepPath sweep_path_ = SweepPath::Auto;
   std::optional<ErosionTables> tables_;  // built on the first erode, rebuilt when the rule changes
 };
 

@@ -56,6 +56,8 @@ class HeightGrid {
     return 0.0;
   }
   double& carry() { return carry_.m3(); }
+  // The heights, row-major (k = iy * nx + ix): the kernel's dense pass reads rows of them at once.
+  const Real* data() const { return z_.data(); }
 
   double height(const Vec2& p) const { return bilinear_height(*this, p); }
   double volume() const { return trapezoid_volume(*this); }

@@ -47,6 +47,8 @@ class BitPlaneIdleCounts {
       x += hi - lo + 1;
     }
   }
+  // Every count back to 0.
+  void clear() { std::fill(bits_.begin(), bits_.end(), std::uint64_t{0}); }
   std::size_t bytes() const { return bits_.capacity() * sizeof(std::uint64_t); }
   // Counts below idle_passes, zero for non-members. O(nodes * P).
   void check(const std::vector<std::uint64_t>& members, std::size_t words_per_row, std::uint16_t idle_passes,

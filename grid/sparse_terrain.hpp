@@ -60,7 +60,10 @@ class SparseGridTerrain final : public Terrain {
   IntegrityReport check() const override;
   double max_slope_deg() const override;
 
-  // For tests and benchmarks.
+  // For tests and benchmarks: every node a member of the active set; which sweep erosion
+  // runs (default Auto: the dense pass when at least an eighth of the nodes are members).
+  void activate_all() { active_.activate_all(); }
+  void set_sweep_path(SweepPath path) { sweep_path_ = path; }
   const GridLayout& layout() const { return heights_.layout(); }
   const SparseHeights<Real>& heights() const { return heights_; }
   const SparseActiveSet& active_set() const { return active_; }
@@ -69,6 +72,7 @@ class SparseGridTerrain final : public Terrain {
   SparseHeights<Real> heights_;
   Stencil stencil_;
   SparseActiveSet active_;
+  SweepPath sweep_path_ = SweepPath::Auto;
   std::optional<ErosionTables> tables_;  // built on the first erode, rebuilt when the rule changes
 };
 
