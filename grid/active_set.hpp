@@ -87,14 +87,40 @@ class BasicActiveSet {
     --size_;
   }
 
-  // No member left (the dense erosion pass rebuilds the set as it goes). O(nodes / 64 + rows)
-  // plus the idle counts' clear.
-  void clear() {
-    std::fill(bits_.begin(), bits_.end(), std::uint64_t{0});
-    std::fill(row_count_.begin(), row_count_.end(), std::uint32_t{0});
+  // The members become exactly the nodes of the 3 x 3 blocks around the nodes set in
+  // `centres` (a bitmap of this set's layout: words_per_row() words per row, padding clear),
+  // each with a fresh idle count: what activate_block for each of them would leave on an
+  // empty set. The dense erosion pass rebuilds the set this way. O(nodes / 64) word
+  // operations plus the idle counts' clear.
+  void assign_blocks(const std::vector<std::uint64_t>& centres) {
     idle_.clear();
     size_ = 0;
+    const std::size_t W = words_per_row_;
+    const unsigned tail = static_cast<unsigned>(nx_ % 64);
+    const std::uint64_t last_mask = tail == 0 ? ~std::uint64_t{0} : (std::uint64_t{1} << tail) - 1;
+    for (std::size_t y = 0; y < ny_; ++y) {
+      std::uint32_t count = 0;
+      for (std::size_t w = 0; w < W; ++w) {
+        // Rows y - 1, y, y + 1, then one column each way (bits carried across words).
+        const auto rows = [&](std::size_t wi) {
+          std::uint64_t m = centres[y * W + wi];
+          if (y > 0) m |= centres[(y - 1) * W + wi];
+          if (y + 1 < ny_) m |= centres[(y + 1) * W + wi];
+          return m;
+        };
+        const std::uint64_t m = rows(w);
+        const std::uint64_t lo = w > 0 ? rows(w - 1) >> 63 : 0;      // bit 63 of the word before
+        const std::uint64_t hi = w + 1 < W ? rows(w + 1) << 63 : 0;  // bit 0 of the word after
+        std::uint64_t d = m | (m << 1) | lo | (m >> 1) | hi;
+        if (w + 1 == W) d &= last_mask;
+        bits_[y * W + w] = d;
+        count += static_cast<std::uint32_t>(bits_in_word(d));
+      }
+      row_count_[y] = count;
+      size_ += count;
+    }
   }
+  std::size_t words_per_row() const { return words_per_row_; }
   // Every node a member with a fresh idle count (tests and benchmarks). O(nodes).
   void activate_all() {
     for (std::size_t iy = 0; iy < ny_; ++iy) {
@@ -126,11 +152,18 @@ class BasicActiveSet {
 
  private:
   // Set bits in a word (no popcnt instruction on baseline x86-64: std::popcount is a
-  // library call there; activate_block adds at most 3 bits per word).
+  // library call there). bits_in loops per bit (activate_block adds at most 3 per word);
+  // bits_in_word is the branch-free SWAR count.
   static int bits_in(std::uint64_t w) {
     int n = 0;
     for (; w != 0; w &= w - 1) ++n;
     return n;
+  }
+  static int bits_in_word(std::uint64_t w) {
+    w = w - ((w >> 1) & 0x5555555555555555ull);
+    w = (w & 0x3333333333333333ull) + ((w >> 2) & 0x3333333333333333ull);
+    w = (w + (w >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+    return static_cast<int>((w * 0x0101010101010101ull) >> 56);
   }
   void set_bits(std::size_t y, std::size_t x0, std::size_t x1) {
     std::uint64_t* row = bits_.data() + y * words_per_row_;

@@ -211,13 +211,18 @@ inline Double2 load2(const Real* p) {
 template <int N, bool Gradient, class Real>
 void unstable_flags(const Real* z, std::size_t nx, const NodeClass& c, double tan_settle2, std::int64_t* out) {
   const auto w = static_cast<std::ptrdiff_t>(nx);
+  // Local copies: `out` could alias the class's arrays as far as the compiler knows.
+  std::ptrdiff_t off[N];
+  double crit[N], margin[N];
+  for (int s = 0; s < N; ++s) off[s] = c.offset[s], crit[s] = c.crit[s], margin[s] = c.margin[s];
+  const double irx = c.inv_run_x, iry = c.inv_run_y;
   const auto flag = [&](std::ptrdiff_t x) {  // one node, scalar
     const double zi = static_cast<double>(z[x]);
     bool u = false;
-    for (int s = 0; s < N; ++s) u |= zi - static_cast<double>(z[x + c.offset[s]]) - c.crit[s] > c.margin[s];
+    for (int s = 0; s < N; ++s) u |= zi - static_cast<double>(z[x + off[s]]) - crit[s] > margin[s];
     if constexpr (Gradient) {
-      const double gx = (static_cast<double>(z[x + 1]) - static_cast<double>(z[x - 1])) * c.inv_run_x;
-      const double gy = (static_cast<double>(z[x + w]) - static_cast<double>(z[x - w])) * c.inv_run_y;
+      const double gx = (static_cast<double>(z[x + 1]) - static_cast<double>(z[x - 1])) * irx;
+      const double gy = (static_cast<double>(z[x + w]) - static_cast<double>(z[x - w])) * iry;
       u |= gx * gx + gy * gy > tan_settle2;
     }
     return static_cast<std::int64_t>(u);
@@ -227,10 +232,10 @@ void unstable_flags(const Real* z, std::size_t nx, const NodeClass& c, double ta
     const Double2 zi = load2(z + x);
     Mask2 u = {0, 0};
 #pragma GCC unroll 8
-    for (int s = 0; s < N; ++s) u |= zi - load2(z + x + c.offset[s]) - c.crit[s] > c.margin[s];
+    for (int s = 0; s < N; ++s) u |= zi - load2(z + x + off[s]) - crit[s] > margin[s];
     if constexpr (Gradient) {
-      const Double2 gx = (load2(z + x + 1) - load2(z + x - 1)) * c.inv_run_x;
-      const Double2 gy = (load2(z + x + w) - load2(z + x - w)) * c.inv_run_y;
+      const Double2 gx = (load2(z + x + 1) - load2(z + x - 1)) * irx;
+      const Double2 gy = (load2(z + x + w) - load2(z + x - w)) * iry;
       u |= gx * gx + gy * gy > tan_settle2;
     }
     std::memcpy(out + x, &u, sizeof u);  // lanes are 0 or -1
@@ -239,8 +244,8 @@ void unstable_flags(const Real* z, std::size_t nx, const NodeClass& c, double ta
 }
 
 // One dense pass: every node visited once, in place (Gauss-Seidel), in the direction the
-// active set's next sweep would take; the active set is rebuilt from the blocks of the nodes
-// that transferred (each a member with a fresh idle count). Same visits, same rule, same
+// active set's next sweep would take; the active set is then rebuilt, word by word, from the
+// blocks of the nodes that transferred (each a member with a fresh idle count). Same visits, same rule, same
 // conservation as the active-set sweep; what differs is which nodes are visited: every node,
 // members or not, once (an active-set sweep visits only members, and live ones again).
 //
@@ -253,14 +258,15 @@ void unstable_flags(const Real* z, std::size_t nx, const NodeClass& c, double ta
 // plain sweep of every node (which is what it runs on other stores, e.g. the sparse grid).
 //
 // Cost: O(nodes) per pass -- the classing vectorised over the row, one visit per unstable node
-// -- plus O(nodes / 64 + rows + counts) to clear the active set.
+// -- plus O(nodes / 64) word operations and the idle counts' clear to rebuild the active set.
 template <int N, bool Gradient, class Store, class Active>
 void dense_pass(Store& store, Active& active, const ErosionTables& t, ErosionReport& report, double& moved) {
   const std::size_t nx = t.layout().nx, ny = t.layout().ny;
   const unsigned pass = active.next_sweep();
   const bool y_up = pass % 2 == 0;
   const bool x_up = (pass / 2) % 2 == 0;
-  active.clear();
+  const std::size_t words = active.words_per_row();
+  std::vector<std::uint64_t> moved_bits(words * ny, 0);  // the nodes that transferred
   constexpr bool kContiguous = requires { store.data(); };
   std::vector<std::int64_t> flags(kContiguous ? nx : 0, 1);  // as wide as a double: one vector lane each
   const double tan_settle2 = t.tan_settle() * t.tan_settle();
@@ -289,9 +295,10 @@ void dense_pass(Store& store, Active& active, const ErosionTables& t, ErosionRep
       since_transfer = 0;
       report.transfers += static_cast<std::size_t>(v.transfers);
       moved += v.moved;
-      active.activate_block(ix, iy);
+      moved_bits[iy * words + ix / 64] |= std::uint64_t{1} << (ix % 64);
     }
   }
+  active.assign_blocks(moved_bits);
   report.updates += nx * ny;
 }
 

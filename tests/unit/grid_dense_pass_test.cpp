@@ -154,6 +154,32 @@ INSTANTIATE_TEST_SUITE_P(RulesStencilsStorage, DensePass,
                                            Case{ErosionRuleKind::Gradient, 4, true}),
                          [](const ::testing::TestParamInfo<Case>& info) { return name(info.param); });
 
+// The dense pass rebuilds the active set word by word: the same members as activate_block
+// per centre, across word boundaries and at the grid's edges.
+TEST(DensePassActiveSet, AssignBlocksIsActivateBlockPerCentre) {
+  for (const std::size_t nx : {std::size_t{5}, std::size_t{64}, std::size_t{130}}) {
+    const std::size_t ny = 7;
+    ActiveSet by_blocks(nx, ny, 2), by_words(nx, ny, 2);
+    std::vector<std::uint64_t> centres(by_words.words_per_row() * ny, 0);
+    std::uint64_t h = 12345;
+    for (std::size_t iy = 0; iy < ny; ++iy)
+      for (std::size_t ix = 0; ix < nx; ++ix) {
+        h = h * 6364136223846793005ull + 1442695040888963407ull;
+        if ((h >> 60) != 0 && ix != 63 && ix != 64 && ix != nx - 1) continue;  // sparse, plus word edges
+        by_blocks.activate_block(ix, iy);
+        centres[iy * by_words.words_per_row() + ix / 64] |= std::uint64_t{1} << (ix % 64);
+      }
+    by_words.activate_all();  // assign_blocks replaces whatever was there
+    by_words.assign_blocks(centres);
+    EXPECT_EQ(by_words.size(), by_blocks.size()) << nx;
+    for (std::size_t iy = 0; iy < ny; ++iy)
+      for (std::size_t ix = 0; ix < nx; ++ix) ASSERT_EQ(by_words.contains(ix, iy), by_blocks.contains(ix, iy));
+    std::vector<std::string> problems;
+    by_words.check(problems);
+    EXPECT_TRUE(problems.empty()) << ::testing::PrintToString(problems);
+  }
+}
+
 // Auto takes the dense pass when many nodes are members, the active-set sweep when few.
 TEST(DensePassChoice, DenseWhenManyActive) {
   EXPECT_TRUE(dense_pass_pays(1000, 8000));
