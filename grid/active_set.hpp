@@ -87,37 +87,75 @@ class BasicActiveSet {
     --size_;
   }
 
-  // The members become exactly the nodes of the 3 x 3 blocks around the nodes set in
-  // `centres` (a bitmap of this set's layout: words_per_row() words per row, padding clear),
-  // each with a fresh idle count: what activate_block for each of them would leave on an
-  // empty set. The dense erosion pass rebuilds the set this way. O(nodes / 64) word
-  // operations plus the idle counts' clear.
-  void assign_blocks(const std::vector<std::uint64_t>& centres) {
-    idle_.clear();
-    size_ = 0;
+  // The smallest box holding every member (inclusive; meaningless when empty()). O(rows +
+  // words of the rows with members), as a sweep's scan.
+  struct Bounds {
+    std::size_t x0, x1, y0, y1;
+    std::size_t nodes() const { return (x1 - x0 + 1) * (y1 - y0 + 1); }
+  };
+  Bounds bounds() const {
+    Bounds b{nx_, 0, ny_, 0};
+    for (std::size_t y = 0; y < ny_; ++y) {
+      if (row_count_[y] == 0) continue;
+      b.y0 = std::min(b.y0, y);
+      b.y1 = y;
+      const std::uint64_t* row = bits_.data() + y * words_per_row_;
+      for (std::size_t w = 0; w < words_per_row_; ++w) {
+        if (row[w] == 0) continue;
+        b.x0 = std::min(b.x0, w * 64 + static_cast<std::size_t>(std::countr_zero(row[w])));
+        b.x1 = std::max(b.x1, w * 64 + 63 - static_cast<std::size_t>(std::countl_zero(row[w])));
+      }
+    }
+    return b;
+  }
+
+  // The bookkeeping of a pass that visited every node of rows y0..y1 once, as a sweep would
+  // leave it: the nodes of the 3 x 3 blocks around the nodes set in `centres` (those that
+  // transferred) become members with a fresh idle count; every other member counts one idle
+  // visit and leaves after idle_passes in a row. `centres` holds rows y0..y1 (words_per_row()
+  // words each, padding clear), and every member lies in rows y0..y1 before the call. (A
+  // sweep differs only for a node activated before its own idle visit: it starts at 1, here
+  // at 0.) The dense erosion pass keeps the set this way. O(words of rows y0 - 1..y1 + 1 +
+  // members).
+  void assign_blocks(const std::vector<std::uint64_t>& centres, std::size_t y0, std::size_t y1) {
     const std::size_t W = words_per_row_;
     const unsigned tail = static_cast<unsigned>(nx_ % 64);
     const std::uint64_t last_mask = tail == 0 ? ~std::uint64_t{0} : (std::uint64_t{1} << tail) - 1;
-    for (std::size_t y = 0; y < ny_; ++y) {
+    const std::size_t ya = y0 > 0 ? y0 - 1 : 0, yb = y1 + 1 < ny_ ? y1 + 1 : y1;
+    const auto centre = [&](std::size_t y, std::size_t w) {
+      return y >= y0 && y <= y1 ? centres[(y - y0) * W + w] : std::uint64_t{0};
+    };
+    for (std::size_t y = ya; y <= yb; ++y) {
       std::uint32_t count = 0;
       for (std::size_t w = 0; w < W; ++w) {
         // Rows y - 1, y, y + 1, then one column each way (bits carried across words).
         const auto rows = [&](std::size_t wi) {
-          std::uint64_t m = centres[y * W + wi];
-          if (y > 0) m |= centres[(y - 1) * W + wi];
-          if (y + 1 < ny_) m |= centres[(y + 1) * W + wi];
-          return m;
+          return centre(y, wi) | (y > 0 ? centre(y - 1, wi) : 0) | (y + 1 < ny_ ? centre(y + 1, wi) : 0);
         };
         const std::uint64_t m = rows(w);
         const std::uint64_t lo = w > 0 ? rows(w - 1) >> 63 : 0;      // bit 63 of the word before
         const std::uint64_t hi = w + 1 < W ? rows(w + 1) << 63 : 0;  // bit 0 of the word after
         std::uint64_t d = m | (m << 1) | lo | (m >> 1) | hi;
         if (w + 1 == W) d &= last_mask;
-        bits_[y * W + w] = d;
-        count += static_cast<std::uint32_t>(bits_in_word(d));
+        std::uint64_t& word = bits_[y * W + w];
+        std::uint64_t kept = word & ~d;  // members not in a block: one more idle visit
+        for (std::uint64_t b = kept; b != 0; b &= b - 1) {
+          const auto bit = static_cast<unsigned>(std::countr_zero(b));
+          if (idle_.count_up(w * 64 + bit, y, idle_passes_)) kept &= ~(std::uint64_t{1} << bit);
+        }
+        for (std::uint64_t b = d; b != 0;) {  // fresh counts, a run of bits at a time
+          const auto lo_bit = static_cast<unsigned>(std::countr_zero(b));
+          const std::uint64_t from = b >> lo_bit;
+          const unsigned run =
+              from == ~std::uint64_t{0} >> lo_bit ? 64 - lo_bit : static_cast<unsigned>(std::countr_one(from));
+          idle_.reset(y, w * 64 + lo_bit, w * 64 + lo_bit + run - 1);
+          b = lo_bit + run >= 64 ? 0 : b & (~std::uint64_t{0} << (lo_bit + run));
+        }
+        word = d | kept;
+        count += static_cast<std::uint32_t>(bits_in_word(word));
       }
+      size_ = size_ - row_count_[y] + count;
       row_count_[y] = count;
-      size_ += count;
     }
   }
   std::size_t words_per_row() const { return words_per_row_; }

@@ -175,14 +175,15 @@ inline VisitResult erosion_visit(Store& store, const ErosionTables& t, std::size
   return r;
 }
 
-// Which sweep erode_ordered runs (tests force one; Auto is what the terrains use).
+// Which sweep erode_ordered runs (tests force one; Auto is what the terrains use). Dense
+// sweeps the active set's bounding box.
 enum class SweepPath { Auto, ActiveSet, Dense };
 
-// The active set's size from which a pass sweeps every node (dense_pass) instead of the
-// members: a dense pass costs ~1/8 of an active-set visit per node (measured,
-// tests/bench/grid_bench.cpp), so it wins once more than about an eighth of the nodes are
-// members.
-inline bool dense_pass_pays(std::size_t active, std::size_t nodes) { return active * 8 >= nodes; }
+// Whether a pass sweeps the box around the active set (dense_pass) rather than its members:
+// a dense pass costs ~1/8 of an active-set visit per node that it skips (measured,
+// tests/bench/grid_bench.cpp), so it wins once the members fill about an eighth of their
+// bounding box.
+inline bool dense_pass_pays(std::size_t active, std::size_t box_nodes) { return active * 8 >= box_nodes; }
 
 // Two heights at p[0..1], widened to double (GCC/Clang vector extensions: one SSE2 register
 // on baseline x86-64; no intrinsics, no FMA, so each lane computes what the scalar code
@@ -203,13 +204,14 @@ inline Double2 load2(const Real* p) {
   }
 }
 
-// Whether each interior node x in [1, nx - 2] of a row of contiguous heights `z` (node
+// Whether each interior node x in [max(1, x0), min(nx - 2, x1)] of a row of contiguous heights `z` (node
 // (0, iy); rows iy - 1 and iy + 1 at -nx and +nx) may transfer: the first half of
 // erosion_visit with the same floating-point expressions, so a node it calls stable is one
 // the visit would leave alone. Two nodes at a time. Interior rows only (every neighbour
 // present: the thresholds are the interior class's).
 template <int N, bool Gradient, class Real>
-void unstable_flags(const Real* z, std::size_t nx, const NodeClass& c, double tan_settle2, std::int64_t* out) {
+void unstable_flags(const Real* z, std::size_t nx, std::size_t x0, std::size_t x1, const NodeClass& c,
+                    double tan_settle2, std::int64_t* out) {
   const auto w = static_cast<std::ptrdiff_t>(nx);
   // Local copies: `out` could alias the class's arrays as far as the compiler knows.
   std::ptrdiff_t off[N];
@@ -227,8 +229,9 @@ void unstable_flags(const Real* z, std::size_t nx, const NodeClass& c, double ta
     }
     return static_cast<std::int64_t>(u);
   };
-  std::ptrdiff_t x = 1;
-  for (; x + 2 < w; x += 2) {
+  std::ptrdiff_t x = std::max<std::ptrdiff_t>(1, static_cast<std::ptrdiff_t>(x0));
+  const std::ptrdiff_t end = std::min<std::ptrdiff_t>(w - 1, static_cast<std::ptrdiff_t>(x1) + 1);  // exclusive
+  for (; x + 2 <= end; x += 2) {
     const Double2 zi = load2(z + x);
     Mask2 u = {0, 0};
 #pragma GCC unroll 8
@@ -240,49 +243,54 @@ void unstable_flags(const Real* z, std::size_t nx, const NodeClass& c, double ta
     }
     std::memcpy(out + x, &u, sizeof u);  // lanes are 0 or -1
   }
-  for (; x + 1 < w; ++x) out[x] = flag(x);
+  for (; x < end; ++x) out[x] = flag(x);
 }
 
-// One dense pass: every node visited once, in place (Gauss-Seidel), in the direction the
-// active set's next sweep would take; the active set is then rebuilt, word by word, from the
-// blocks of the nodes that transferred (each a member with a fresh idle count). Same visits, same rule, same
-// conservation as the active-set sweep; what differs is which nodes are visited: every node,
-// members or not, once (an active-set sweep visits only members, and live ones again).
+// One dense pass: every node of the box `b` (the active set's bounds) visited once, in place
+// (Gauss-Seidel), in the direction the active set's next sweep would take; the active set is
+// then rebuilt, word by word, from the blocks of the nodes that transferred (each a member
+// with a fresh idle count). Same visits, same rule, same conservation as the active-set
+// sweep; what differs is which nodes are visited: every node of the box, members or not,
+// once (an active-set sweep visits only members, and those activated ahead of it again).
 //
-// Exactness of the shortcut. On a store with contiguous heights (HeightGrid: data()), the
+// Exactness of the shortcut. On a store with contiguous heights (HeightGrid: data()), a
 // row's nodes are first classed by unstable_flags, computed after the previous row is done;
 // a node is then visited only if it is flagged, on a border, or one of the two nodes before
 // it in the row transferred (a visit writes into its 3 x 3 block, which a node up to two
 // columns away reads). Its inputs are otherwise those it was classed with, so skipping it is
 // exactly what its visit would have done: the pass gives the same heights, bit for bit, as a
-// plain sweep of every node (which is what it runs on other stores, e.g. the sparse grid).
+// plain sweep of every node of the box (which is what it runs on other stores, e.g. the
+// sparse grid).
 //
-// Cost: O(nodes) per pass -- the classing vectorised over the row, one visit per unstable node
-// -- plus O(nodes / 64) word operations and the idle counts' clear to rebuild the active set.
+// Cost: O(box nodes) per pass -- the classing vectorised over the row, one visit per unstable
+// node -- plus O(words of the box's rows) to find the box and to rebuild the active set.
 template <int N, bool Gradient, class Store, class Active>
-void dense_pass(Store& store, Active& active, const ErosionTables& t, ErosionReport& report, double& moved) {
+void dense_pass(Store& store, Active& active, const typename Active::Bounds& b, const ErosionTables& t,
+                ErosionReport& report, double& moved) {
   const std::size_t nx = t.layout().nx, ny = t.layout().ny;
+  const std::size_t width = b.x1 - b.x0 + 1, height = b.y1 - b.y0 + 1;
   const unsigned pass = active.next_sweep();
   const bool y_up = pass % 2 == 0;
   const bool x_up = (pass / 2) % 2 == 0;
   const std::size_t words = active.words_per_row();
-  std::vector<std::uint64_t> moved_bits(words * ny, 0);  // the nodes that transferred
+  std::vector<std::uint64_t> moved_bits(words * height, 0);  // rows y0..y1: the nodes that transferred
   constexpr bool kContiguous = requires { store.data(); };
   std::vector<std::int64_t> flags(kContiguous ? nx : 0, 1);  // as wide as a double: one vector lane each
   const double tan_settle2 = t.tan_settle() * t.tan_settle();
-  for (std::size_t r = 0; r < ny; ++r) {
-    const std::size_t iy = y_up ? r : ny - 1 - r;
+  for (std::size_t r = 0; r < height; ++r) {
+    const std::size_t iy = y_up ? b.y0 + r : b.y1 - r;
     const bool interior_row = iy > 0 && iy + 1 < ny && nx >= 3;
     const NodeClass& middle = t.of(nx / 2, iy);
     if constexpr (kContiguous) {
-      if (interior_row) unstable_flags<N, Gradient>(store.data() + iy * nx, nx, middle, tan_settle2, flags.data());
+      if (interior_row)
+        unstable_flags<N, Gradient>(store.data() + iy * nx, nx, b.x0, b.x1, middle, tan_settle2, flags.data());
     }
     int since_transfer = 3;  // nodes visited since the last one that transferred, in this row
-    for (std::size_t c = 0; c < nx; ++c) {
-      const std::size_t ix = x_up ? c : nx - 1 - c;
+    for (std::size_t c = 0; c < width; ++c) {
+      const std::size_t ix = x_up ? b.x0 + c : b.x1 - c;
       const bool edge = ix < 2 || ix + 2 >= nx;
       if constexpr (kContiguous) {
-        if (interior_row && since_transfer > 2 && !flags[ix] && ix > 0 && ix + 1 < nx) {
+        if (interior_row && since_transfer > 2 && ix > 0 && ix + 1 < nx && !flags[ix]) {
           ++since_transfer;
           continue;
         }
@@ -295,30 +303,33 @@ void dense_pass(Store& store, Active& active, const ErosionTables& t, ErosionRep
       since_transfer = 0;
       report.transfers += static_cast<std::size_t>(v.transfers);
       moved += v.moved;
-      moved_bits[iy * words + ix / 64] |= std::uint64_t{1} << (ix % 64);
+      moved_bits[(iy - b.y0) * words + ix / 64] |= std::uint64_t{1} << (ix % 64);
     }
   }
-  active.assign_blocks(moved_bits);
-  report.updates += nx * ny;
+  active.assign_blocks(moved_bits, b.y0, b.y1);
+  report.updates += width * height;
 }
 
 // Passes until `active` is empty or the budget is spent: ordered, live sweeps of the active
-// set (see active_set.hpp for the order), or a dense pass (dense_pass) when most nodes are
-// members and the budget allows a whole pass. Cost: O(visits) plus the set's O(rows) per
-// active-set sweep, O(nodes) per dense pass.
+// set (see active_set.hpp for the order), or a dense pass over the set's bounding box
+// (dense_pass) when the members fill enough of it and the budget allows the whole box.
+// Cost: O(visits) plus the set's O(rows) per active-set sweep, O(box nodes) per dense pass.
 template <int N, bool Gradient, class Store, class Active>
 ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t, const ErosionBudget& budget,
                             SweepPath path = SweepPath::Auto) {
   ErosionReport report;
-  const std::size_t nx = t.layout().nx, nodes = t.layout().nodes();
+  const std::size_t nx = t.layout().nx;
   double moved = 0.0;
   while (report.passes < budget.max_passes && !active.empty() && report.updates < budget.max_updates) {
     ++report.passes;
-    const bool dense = path == SweepPath::Dense || (path == SweepPath::Auto && dense_pass_pays(active.size(), nodes) &&
-                                                    budget.max_updates - report.updates >= nodes);
-    if (dense) {
-      dense_pass<N, Gradient>(store, active, t, report, moved);
-      continue;
+    if (path != SweepPath::ActiveSet) {
+      const typename Active::Bounds b = active.bounds();
+      const bool dense = path == SweepPath::Dense || (dense_pass_pays(active.size(), b.nodes()) &&
+                                                      budget.max_updates - report.updates >= b.nodes());
+      if (dense) {
+        dense_pass<N, Gradient>(store, active, b, t, report, moved);
+        continue;
+      }
     }
     report.updates += active.sweep(budget.max_updates - report.updates, [&](std::size_t ix, std::size_t iy) {
       const VisitResult v = erosion_visit<N, Gradient>(store, t, iy * nx + ix, t.of(ix, iy));

@@ -154,8 +154,8 @@ INSTANTIATE_TEST_SUITE_P(RulesStencilsStorage, DensePass,
                                            Case{ErosionRuleKind::Gradient, 4, true}),
                          [](const ::testing::TestParamInfo<Case>& info) { return name(info.param); });
 
-// The dense pass rebuilds the active set word by word: the same members as activate_block
-// per centre, across word boundaries and at the grid's edges.
+// The dense pass keeps the active set word by word: the same members as activate_block per
+// centre, across word boundaries and at the grid's edges; idle members leave after idle_passes.
 TEST(DensePassActiveSet, AssignBlocksIsActivateBlockPerCentre) {
   for (const std::size_t nx : {std::size_t{5}, std::size_t{64}, std::size_t{130}}) {
     const std::size_t ny = 7;
@@ -169,12 +169,20 @@ TEST(DensePassActiveSet, AssignBlocksIsActivateBlockPerCentre) {
         by_blocks.activate_block(ix, iy);
         centres[iy * by_words.words_per_row() + ix / 64] |= std::uint64_t{1} << (ix % 64);
       }
-    by_words.activate_all();  // assign_blocks replaces whatever was there
-    by_words.assign_blocks(centres);
+    by_words.assign_blocks(centres, 0, ny - 1);
     EXPECT_EQ(by_words.size(), by_blocks.size()) << nx;
     for (std::size_t iy = 0; iy < ny; ++iy)
       for (std::size_t ix = 0; ix < nx; ++ix) ASSERT_EQ(by_words.contains(ix, iy), by_blocks.contains(ix, iy));
     std::vector<std::string> problems;
+    by_words.check(problems);
+    EXPECT_TRUE(problems.empty()) << ::testing::PrintToString(problems);
+    // Members of no block count an idle visit: with idle_passes = 2 they stay one pass more.
+    const std::vector<std::uint64_t> none(centres.size(), 0);
+    const std::size_t members = by_words.size();
+    by_words.assign_blocks(none, 0, ny - 1);
+    EXPECT_EQ(by_words.size(), members);
+    by_words.assign_blocks(none, 0, ny - 1);
+    EXPECT_EQ(by_words.size(), 0u);
     by_words.check(problems);
     EXPECT_TRUE(problems.empty()) << ::testing::PrintToString(problems);
   }

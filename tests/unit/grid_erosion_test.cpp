@@ -127,25 +127,31 @@ TYPED_TEST(GridErosion, ObeysTheUpdateBudget) {
 }
 
 TYPED_TEST(GridErosion, IdleNodesLeaveAfterIdlePasses) {
-  const Scene s = scene({"erosion.idle_passes=3"});
-  const auto t = make_grid<TypeParam>(s);
-  ToolStamp drop = column();
-  drop.pour_volume_m3 = 1e-9;  // a film far below the angle of repose
-  t->stamp(drop);
-  const std::size_t active = t->stats().active;
-  ASSERT_GT(active, 49u);
-  ErosionReport r = t->erode(rule_of(s), {.max_passes = 2});
-  EXPECT_EQ(r.passes, 2);
-  EXPECT_EQ(r.transfers, 0u);
-  EXPECT_EQ(r.updates, 2 * active);
-  EXPECT_EQ(r.active, active);
-  SB_EXPECT_CHECK_OK(*t);
-  r = t->erode(rule_of(s), {.max_passes = 5});
-  EXPECT_EQ(r.passes, 1);
-  EXPECT_EQ(r.active, 0u);
-  SB_EXPECT_CHECK_OK(*t);
-  r = t->erode(rule_of(s), {.max_passes = 5});
-  EXPECT_EQ(r.passes, 0);
+  // On both sweeps: the active set's (which visits the members) and the dense pass (which
+  // visits their bounding box).
+  for (const SweepPath path : {SweepPath::ActiveSet, SweepPath::Dense}) {
+    const Scene s = scene({"erosion.idle_passes=3"});
+    const auto t = make_grid<TypeParam>(s);
+    t->set_sweep_path(path);
+    ToolStamp drop = column();
+    drop.pour_volume_m3 = 1e-9;  // a film far below the angle of repose
+    t->stamp(drop);
+    const std::size_t active = t->stats().active;
+    ASSERT_GT(active, 49u);
+    const std::size_t visited = path == SweepPath::Dense ? t->active_set().bounds().nodes() : active;
+    ErosionReport r = t->erode(rule_of(s), {.max_passes = 2});
+    EXPECT_EQ(r.passes, 2);
+    EXPECT_EQ(r.transfers, 0u);
+    EXPECT_EQ(r.updates, 2 * visited);
+    EXPECT_EQ(r.active, active);
+    SB_EXPECT_CHECK_OK(*t);
+    r = t->erode(rule_of(s), {.max_passes = 5});
+    EXPECT_EQ(r.passes, 1);
+    EXPECT_EQ(r.active, 0u);
+    SB_EXPECT_CHECK_OK(*t);
+    r = t->erode(rule_of(s), {.max_passes = 5});
+    EXPECT_EQ(r.passes, 0);
+  }
 }
 
 TYPED_TEST(GridErosion, SameInputGivesTheSameSurface) {
