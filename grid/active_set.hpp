@@ -87,26 +87,32 @@ class BasicActiveSet {
     --size_;
   }
 
-  // The smallest box holding every member (inclusive; meaningless when empty()). O(rows +
-  // words of the rows with members), as a sweep's scan.
-  struct Bounds {
-    std::size_t x0, x1, y0, y1;
-    std::size_t nodes() const { return (x1 - x0 + 1) * (y1 - y0 + 1); }
+  // The first and last member of row y (false: none). O(words of the row).
+  bool row_span(std::size_t y, std::size_t& x0, std::size_t& x1) const {
+    if (row_count_[y] == 0) return false;
+    const std::uint64_t* row = bits_.data() + y * words_per_row_;
+    std::size_t a = 0, b = words_per_row_ - 1;
+    while (row[a] == 0) ++a;
+    while (row[b] == 0) --b;
+    x0 = a * 64 + static_cast<std::size_t>(std::countr_zero(row[a]));
+    x1 = b * 64 + 63 - static_cast<std::size_t>(std::countl_zero(row[b]));
+    return true;
+  }
+  // The rows holding members (y0..y1, meaningless when empty()) and the nodes between the
+  // first and last member of each row, summed. O(rows + words of the rows with members).
+  struct Spans {
+    std::size_t y0, y1, nodes;
   };
-  Bounds bounds() const {
-    Bounds b{nx_, 0, ny_, 0};
+  Spans spans() const {
+    Spans r{ny_, 0, 0};
     for (std::size_t y = 0; y < ny_; ++y) {
-      if (row_count_[y] == 0) continue;
-      b.y0 = std::min(b.y0, y);
-      b.y1 = y;
-      const std::uint64_t* row = bits_.data() + y * words_per_row_;
-      for (std::size_t w = 0; w < words_per_row_; ++w) {
-        if (row[w] == 0) continue;
-        b.x0 = std::min(b.x0, w * 64 + static_cast<std::size_t>(std::countr_zero(row[w])));
-        b.x1 = std::max(b.x1, w * 64 + 63 - static_cast<std::size_t>(std::countl_zero(row[w])));
-      }
+      std::size_t x0, x1;
+      if (!row_span(y, x0, x1)) continue;
+      r.y0 = std::min(r.y0, y);
+      r.y1 = y;
+      r.nodes += x1 - x0 + 1;
     }
-    return b;
+    return r;
   }
 
   // The bookkeeping of a pass that visited every node of rows y0..y1 once, as a sweep would

@@ -20,11 +20,14 @@
 //   double put(std::size_t k, double z);  // stores z (rounded); returns z - stored (0 if exact)
 //   double& carry();                      // volume (m^3) owed by rounding; read and written
 //                                         // only when kRounds
-// Active-set concept (grid/active_set.hpp is the dense one):
+// Active-set concept (grid/active_set.hpp, BasicActiveSet, for both grids):
 //   bool empty() const; std::size_t size() const;
 //   template <class V> std::size_t sweep(std::size_t max_visits, V&& visit);
 //       visit(ix, iy) -> bool transferred; the set marks idle nodes, the caller activates
 //   void activate_block(std::size_t ix, std::size_t iy);  // node and its 3 x 3 block
+//   Spans spans() const; bool row_span(y, x0&, x1&) const; unsigned next_sweep();
+//   std::size_t words_per_row() const;
+//   void assign_blocks(centres, y0, y1);  // the dense pass's bookkeeping
 // Node indices are those of the GridLayout (k = iy * nx + ix); a sparse store maps them to
 // its own coordinates.
 //
@@ -34,16 +37,47 @@
 // store's carry go into the centre's write, whose own error becomes the new carry: the
 // stored volume never drifts by more than one rounding step (height_grid.hpp).
 //
-// Energy. Sweeps are Gauss-Seidel (each visit sees the heights left by the visits before
-// it) and each visit moves at most f times the largest pair excess, split in proportion to
-// the pair excesses: for f <= 1 no pair passes the level at which it would be exactly at
-// the critical slope, so each transfer lowers the potential energy sum A z^2 / 2
-// (it moves mass downhill without inverting the pair); f in (1, 2] may overshoot a pair
-// but still contracts it (the scene refuses f > 2).
+// Two sweeps (erode_ordered chooses per pass). The active-set sweep visits the members in
+// an alternating, live order (active_set.hpp). The dense pass (dense_pass) visits every node
+// from the first to the last member of each row (its span), in row order, and is taken when
+// the members fill at least an eighth of the spans: it first classes a row's nodes with
+// vector arithmetic (reads only)
+// and visits only those that may transfer, which costs about a sixth of an active-set visit
+// per node it skips (instructions, callgrind) and no bookkeeping per visit (the active set
+// is rebuilt word by word after the pass). Both write in place, one node at a time, in a
+// fixed order; the vector part never writes, so both are Gauss-Seidel sweeps with the
+// conservation above and the energy argument below. They differ in which nodes they visit
+// (the dense pass also visits non-members in the spans; the active-set sweep revisits members
+// activated ahead of it), so their results differ in the order grains stop, not in
+// conservation: measured identical on random rough states (tests/unit/grid_dense_pass_test.cpp)
+// and within the goldens' bounds on the shipped scenes. The choice depends only on the
+// active set, so the dense and sparse grids still compute the same heights bit for bit.
+//
+// Energy. Each visit sees the heights left by the visits before it, and moves at most f
+// times the largest pair excess, split in proportion to the pair excesses: for f <= 1 no
+// pair passes the level at which it would be exactly at the critical slope, so each
+// transfer lowers the potential energy sum A z^2 / 2 (it moves mass downhill without
+// inverting the pair); f in (1, 2] may overshoot a pair but still contracts it (the scene
+// refuses f > 2).
+//
+// Why not a Jacobi (two-pass) sweep. If every node's transfers were computed from the same
+// old heights and applied together, a node could receive from all its neighbours at once.
+// With equal areas A and one pair each, a neighbour i with excess height x over a pit j
+// (drop = d tan_critical + x) sends V = f x A / 2: i falls by f x / 2, and the pit rises
+// by N f x / 2 if all N neighbours do the same. The pair's excess becomes
+// x (1 - f (N + 1) / 2): the pass conserves volume exactly (each V is taken and given once)
+// but is monotone in energy (no pair inverted) only for f <= 2 / (N + 1), 0.22 with 8
+// neighbours, 0.4 with 4. At the default f = 0.5 an 8-neighbour pit overshoots to
+// -1.25 x (it becomes a peak), so a Jacobi sweep would need a fraction 2.25x smaller, and
+// about that many more passes to settle: the dense pass stays Gauss-Seidel and vectorises
+// only its reads.
 //
 // Cost per visit: 9 height loads (4-neighbour: 5), ~6 floating-point operations per
 // neighbour, plus per transfer one division, one store per receiving neighbour and one
-// for the centre; the gradient rule adds a square root and a division per visit.
+// for the centre; the gradient rule adds a square root and a division per visit. Measured
+// (tests/bench/grid_bench.cpp, callgrind): ~180 instructions per visited node in a dense
+// pass where most visited nodes transfer, ~36 per node to class a row (8 neighbours,
+// double); active-set visits add ~100 for the set's bookkeeping.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -176,14 +210,14 @@ inline VisitResult erosion_visit(Store& store, const ErosionTables& t, std::size
 }
 
 // Which sweep erode_ordered runs (tests force one; Auto is what the terrains use). Dense
-// sweeps the active set's bounding box.
+// sweeps the members' row spans.
 enum class SweepPath { Auto, ActiveSet, Dense };
 
-// Whether a pass sweeps the box around the active set (dense_pass) rather than its members:
-// a dense pass costs ~1/8 of an active-set visit per node that it skips (measured,
-// tests/bench/grid_bench.cpp), so it wins once the members fill about an eighth of their
-// bounding box.
-inline bool dense_pass_pays(std::size_t active, std::size_t box_nodes) { return active * 8 >= box_nodes; }
+// Whether a pass sweeps the members' row spans (dense_pass) rather than the members: a dense
+// pass costs about a sixth of an active-set visit per node it skips (instructions,
+// callgrind; tests/bench/grid_bench.cpp), so it pays once the members fill about an eighth of
+// the spans from the first to the last member of each row.
+inline bool dense_pass_pays(std::size_t active, std::size_t span_nodes) { return active * 8 >= span_nodes; }
 
 // Two heights at p[0..1], widened to double (GCC/Clang vector extensions: one SSE2 register
 // on baseline x86-64; no intrinsics, no FMA, so each lane computes what the scalar code
@@ -246,11 +280,15 @@ void unstable_flags(const Real* z, std::size_t nx, std::size_t x0, std::size_t x
   for (; x < end; ++x) out[x] = flag(x);
 }
 
-// One dense pass: every node of the box `b` (the active set's bounds) visited once, in place
-// (Gauss-Seidel), in the direction the active set's next sweep would take; the active set is
-// then rebuilt, word by word, from the blocks of the nodes that transferred (each a member
-// with a fresh idle count). Same visits, same rule, same conservation as the active-set
-// sweep; what differs is which nodes are visited: every node of the box, members or not,
+// One dense pass, in place (Gauss-Seidel), in the direction the active set's next sweep
+// would take: in each row, every node from the first to the last member (the row's span)
+// is visited once. Like the active-set sweep it is live: a row's span also covers the nodes
+// next to those that transferred in the row before (the blocks activate_block would have
+// added, so rows beyond the members are reached too), and grows past its end while the node
+// at the end transfers. The active set is then updated word by word (assign_blocks): the
+// blocks of the nodes that transferred become members with a fresh idle count, other
+// members count an idle visit. Same visits, same rule, same conservation as the active-set
+// sweep; what differs is which nodes are visited: every node of the spans, members or not,
 // once (an active-set sweep visits only members, and those activated ahead of it again).
 //
 // Exactness of the shortcut. On a store with contiguous heights (HeightGrid: data()), a
@@ -258,62 +296,102 @@ void unstable_flags(const Real* z, std::size_t nx, std::size_t x0, std::size_t x
 // a node is then visited only if it is flagged, on a border, or one of the two nodes before
 // it in the row transferred (a visit writes into its 3 x 3 block, which a node up to two
 // columns away reads). Its inputs are otherwise those it was classed with, so skipping it is
-// exactly what its visit would have done: the pass gives the same heights, bit for bit, as a
-// plain sweep of every node of the box (which is what it runs on other stores, e.g. the
-// sparse grid).
+// exactly what its visit would have done: the pass gives the same heights, bit for bit, as
+// visiting every node of the spans (which is what it does on other stores, e.g. the sparse
+// grid).
 //
-// Cost: O(box nodes) per pass -- the classing vectorised over the row, one visit per unstable
-// node -- plus O(words of the box's rows) to find the box and to rebuild the active set.
+// Cost: O(span nodes) per pass -- the classing vectorised over the row, one visit per
+// unstable node -- plus O(words of the visited rows) to find the spans and update the set.
 template <int N, bool Gradient, class Store, class Active>
-void dense_pass(Store& store, Active& active, const typename Active::Bounds& b, const ErosionTables& t,
+void dense_pass(Store& store, Active& active, const typename Active::Spans& spans, const ErosionTables& t,
                 ErosionReport& report, double& moved) {
   const std::size_t nx = t.layout().nx, ny = t.layout().ny;
-  const std::size_t width = b.x1 - b.x0 + 1, height = b.y1 - b.y0 + 1;
   const unsigned pass = active.next_sweep();
   const bool y_up = pass % 2 == 0;
   const bool x_up = (pass / 2) % 2 == 0;
   const std::size_t words = active.words_per_row();
-  std::vector<std::uint64_t> moved_bits(words * height, 0);  // rows y0..y1: the nodes that transferred
+  // The nodes that transferred, one row of words per visited row in visiting order.
+  std::vector<std::uint64_t> moved_bits;
   constexpr bool kContiguous = requires { store.data(); };
   std::vector<std::int64_t> flags(kContiguous ? nx : 0, 1);  // as wide as a double: one vector lane each
   const double tan_settle2 = t.tan_settle() * t.tan_settle();
-  for (std::size_t r = 0; r < height; ++r) {
-    const std::size_t iy = y_up ? b.y0 + r : b.y1 - r;
+  std::size_t prev_lo = 1, prev_hi = 0;  // span of the previous row's transfers (empty)
+  std::size_t visited_rows = 0;
+  const std::size_t first = y_up ? spans.y0 : spans.y1;
+  for (std::size_t iy = first; iy < ny; iy = y_up ? iy + 1 : iy - 1) {  // iy - 1 wraps below 0: stops
+    std::size_t x0 = nx, x1 = 0;
+    const bool members = active.row_span(iy, x0, x1);
+    const bool live = prev_lo <= prev_hi;
+    const bool inside = y_up ? iy <= spans.y1 : iy >= spans.y0;
+    if (!members && !live && !inside) break;
+    if (live) {  // the blocks of the previous row's transfers
+      x0 = std::min(x0, prev_lo > 0 ? prev_lo - 1 : 0);
+      x1 = std::max(x1, std::min(prev_hi + 1, nx - 1));
+    }
+    moved_bits.resize(moved_bits.size() + words, 0);
+    std::uint64_t* moved_row = moved_bits.data() + visited_rows * words;
+    ++visited_rows;
+    prev_lo = 1, prev_hi = 0;
+    if (!members && !live) continue;  // a row inside the members' rows with none
     const bool interior_row = iy > 0 && iy + 1 < ny && nx >= 3;
     const NodeClass& middle = t.of(nx / 2, iy);
     if constexpr (kContiguous) {
       if (interior_row)
-        unstable_flags<N, Gradient>(store.data() + iy * nx, nx, b.x0, b.x1, middle, tan_settle2, flags.data());
+        unstable_flags<N, Gradient>(store.data() + iy * nx, nx, x0, x1, middle, tan_settle2, flags.data());
     }
-    int since_transfer = 3;  // nodes visited since the last one that transferred, in this row
-    for (std::size_t c = 0; c < width; ++c) {
-      const std::size_t ix = x_up ? b.x0 + c : b.x1 - c;
+    const std::size_t flagged_lo = x0, flagged_hi = x1;
+    std::size_t row_lo = nx, row_hi = 0;  // span of this row's transfers (empty)
+    int since_transfer = 3;               // nodes visited since the last one that transferred, in this row
+    std::size_t ix = x_up ? x0 : x1;
+    while (true) {
       const bool edge = ix < 2 || ix + 2 >= nx;
-      if constexpr (kContiguous) {
-        if (interior_row && since_transfer > 2 && ix > 0 && ix + 1 < nx && !flags[ix]) {
-          ++since_transfer;
-          continue;
+      bool skip = false;
+      if constexpr (kContiguous)
+        skip = interior_row && since_transfer > 2 && ix > 0 && ix + 1 < nx && ix >= flagged_lo && ix <= flagged_hi &&
+               !flags[ix];
+      bool transferred = false;
+      if (!skip) {
+        const VisitResult v = erosion_visit<N, Gradient>(store, t, iy * nx + ix, edge ? t.of(ix, iy) : middle);
+        if (v.transfers > 0) {
+          transferred = true;
+          report.transfers += static_cast<std::size_t>(v.transfers);
+          moved += v.moved;
+          moved_row[ix / 64] |= std::uint64_t{1} << (ix % 64);
+          row_lo = std::min(row_lo, ix);
+          row_hi = std::max(row_hi, ix);
         }
       }
-      const VisitResult v = erosion_visit<N, Gradient>(store, t, iy * nx + ix, edge ? t.of(ix, iy) : middle);
-      if (v.transfers == 0) {
-        ++since_transfer;
-        continue;
+      since_transfer = transferred ? 0 : since_transfer + 1;
+      ++report.updates;
+      // Next node; past the span's end only while the node at the end transferred (its
+      // block reaches one node further).
+      if (x_up) {
+        if (ix == nx - 1 || (ix >= x1 && !transferred)) break;
+        x1 = std::max(x1, ix + 1);
+        ++ix;
+      } else {
+        if (ix == 0 || (ix <= x0 && !transferred)) break;
+        x0 = std::min(x0, ix - 1);
+        --ix;
       }
-      since_transfer = 0;
-      report.transfers += static_cast<std::size_t>(v.transfers);
-      moved += v.moved;
-      moved_bits[(iy - b.y0) * words + ix / 64] |= std::uint64_t{1} << (ix % 64);
     }
+    if (row_lo <= row_hi) prev_lo = row_lo, prev_hi = row_hi;
   }
-  active.assign_blocks(moved_bits, b.y0, b.y1);
-  report.updates += width * height;
+  // Rows in increasing y for the set.
+  const std::size_t last = y_up ? first + visited_rows - 1 : first - (visited_rows - 1);
+  if (!y_up)
+    for (std::size_t a = 0, b = visited_rows - 1; a < b; ++a, --b)
+      std::swap_ranges(moved_bits.begin() + static_cast<std::ptrdiff_t>(a * words),
+                       moved_bits.begin() + static_cast<std::ptrdiff_t>((a + 1) * words),
+                       moved_bits.begin() + static_cast<std::ptrdiff_t>(b * words));
+  active.assign_blocks(moved_bits, std::min(first, last), std::max(first, last));
 }
 
 // Passes until `active` is empty or the budget is spent: ordered, live sweeps of the active
-// set (see active_set.hpp for the order), or a dense pass over the set's bounding box
-// (dense_pass) when the members fill enough of it and the budget allows the whole box.
-// Cost: O(visits) plus the set's O(rows) per active-set sweep, O(box nodes) per dense pass.
+// set (see active_set.hpp for the order), or a dense pass over the members' row spans
+// (dense_pass) when the members fill enough of them and the budget allows twice the spans.
+// Cost: O(visits) plus the set's O(rows + words with members) per pass, O(span nodes) per
+// dense pass.
 template <int N, bool Gradient, class Store, class Active>
 ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t, const ErosionBudget& budget,
                             SweepPath path = SweepPath::Auto) {
@@ -323,11 +401,11 @@ ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t
   while (report.passes < budget.max_passes && !active.empty() && report.updates < budget.max_updates) {
     ++report.passes;
     if (path != SweepPath::ActiveSet) {
-      const typename Active::Bounds b = active.bounds();
-      const bool dense = path == SweepPath::Dense || (dense_pass_pays(active.size(), b.nodes()) &&
-                                                      budget.max_updates - report.updates >= b.nodes());
+      const typename Active::Spans spans = active.spans();
+      const bool dense = path == SweepPath::Dense || (dense_pass_pays(active.size(), spans.nodes) &&
+                                                      budget.max_updates - report.updates >= 2 * spans.nodes);
       if (dense) {
-        dense_pass<N, Gradient>(store, active, b, t, report, moved);
+        dense_pass<N, Gradient>(store, active, spans, t, report, moved);
         continue;
       }
     }

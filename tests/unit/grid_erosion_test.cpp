@@ -128,7 +128,7 @@ TYPED_TEST(GridErosion, ObeysTheUpdateBudget) {
 
 TYPED_TEST(GridErosion, IdleNodesLeaveAfterIdlePasses) {
   // On both sweeps: the active set's (which visits the members) and the dense pass (which
-  // visits their bounding box).
+  // visits their row spans).
   for (const SweepPath path : {SweepPath::ActiveSet, SweepPath::Dense}) {
     const Scene s = scene({"erosion.idle_passes=3"});
     const auto t = make_grid<TypeParam>(s);
@@ -138,7 +138,7 @@ TYPED_TEST(GridErosion, IdleNodesLeaveAfterIdlePasses) {
     t->stamp(drop);
     const std::size_t active = t->stats().active;
     ASSERT_GT(active, 49u);
-    const std::size_t visited = path == SweepPath::Dense ? t->active_set().bounds().nodes() : active;
+    const std::size_t visited = path == SweepPath::Dense ? t->active_set().spans().nodes : active;
     ErosionReport r = t->erode(rule_of(s), {.max_passes = 2});
     EXPECT_EQ(r.passes, 2);
     EXPECT_EQ(r.transfers, 0u);
