@@ -105,5 +105,94 @@ TEST(Reference, TrenchWallAngleAndDepth) {
   EXPECT_NEAR(s.wall_angle_deg, 30.0, 0.5);
 }
 
+// A trench along azimuth 22.5 degrees (between the grid's stencil directions) whose walls stand
+// at 30 degrees on one side and 34 on the other: the section statistics see both.
+TEST(Reference, TrenchSectionStatisticsAtAnAzimuth) {
+  Raster initial = Raster::covering({{0, 0}, {0.3, 0.3}}, 0.001), trench = initial;
+  const double az = 22.5 * std::numbers::pi / 180.0;
+  const Vec2 centre(0.15, 0.15), along(std::cos(az), std::sin(az)), across(-along.y(), along.x());
+  for (std::size_t iy = 0; iy < initial.ny; ++iy)
+    for (std::size_t ix = 0; ix < initial.nx; ++ix) {
+      initial.at(ix, iy) = 0.1;
+      const double d = (initial.point(ix, iy) - centre).dot(across);
+      const double t = std::tan((d > 0 ? 34.0 : 30.0) * std::numbers::pi / 180.0);
+      trench.at(ix, iy) = std::min(0.1, 0.09 + std::max(0.0, std::abs(d) - 0.01) * t);
+    }
+  const TrenchShape s = measure_trench(trench, initial, centre - 0.1 * along, centre + 0.1 * along);
+  EXPECT_EQ(s.sections, 22);
+  EXPECT_NEAR(s.depth_m, 0.01, 1e-6);
+  EXPECT_NEAR(s.wall_angle_deg, 34.0, 0.2);
+  EXPECT_NEAR(s.wall_angle_min_deg, 30.0, 0.2);
+  EXPECT_NEAR(s.wall_angle_mean_deg, 32.0, 0.2);
+  EXPECT_NEAR(s.wall_angle_spread_deg, 2.0, 0.1);
+  EXPECT_NEAR(s.worst_error_deg(31.0), 3.0, 0.2);
+}
+
+// A ridge of triangular section at 67.5 degrees, flanks at 30 degrees, 10 mm high: measured as
+// the walls of the negated surface, with the crest's height above the initial surface.
+TEST(Reference, RidgeFlanksAtAnAzimuth) {
+  Raster initial = Raster::covering({{0, 0}, {0.3, 0.3}}, 0.001), ridge = initial;
+  const double az = 67.5 * std::numbers::pi / 180.0, t = std::tan(std::numbers::pi / 6);
+  const Vec2 centre(0.15, 0.15), along(std::cos(az), std::sin(az)), across(-along.y(), along.x());
+  for (std::size_t iy = 0; iy < initial.ny; ++iy)
+    for (std::size_t ix = 0; ix < initial.nx; ++ix) {
+      initial.at(ix, iy) = 0.05;
+      const double d = std::abs((initial.point(ix, iy) - centre).dot(across));
+      ridge.at(ix, iy) = 0.05 + std::max(0.0, 0.01 - d * t);
+    }
+  const TrenchShape s = measure_ridge(ridge, initial, centre - 0.1 * along, centre + 0.1 * along);
+  EXPECT_EQ(s.sections, 22);
+  EXPECT_NEAR(s.depth_m, 0.01, 5e-4);  // bilinear interpolation cuts the sharp crest
+  EXPECT_NEAR(s.wall_angle_mean_deg, 30.0, 0.2);
+  EXPECT_NEAR(s.wall_angle_deg, 30.0, 0.3);
+  EXPECT_LT(s.wall_angle_spread_deg, 0.2);
+}
+
+// The plane terrain of a scene at 30 degrees toward 67.5 degrees: the fit and the local slopes
+// find it; a step across the middle leaves the fit near 30 but not the steepest local slope.
+TEST(Reference, PlaneSlopeAzimuthAndLocalSlopes) {
+  const Scene s = parse_scene(R"(
+[domain]
+size_m = [0.2, 0.2]
+[terrain]
+kind = "plane"
+height_m = 0.1
+slope_deg = 30.0
+azimuth_deg = 67.5
+[tool]
+shape = "pour"
+radius_m = 0.004
+volume_m3 = 1e-9
+[stroke]
+path_m = [[0.1, 0.1]]
+[reference]
+kind = "plane"
+[output]
+raster_m = 0.0025
+)",
+                              "plane");
+  const HeightField f = HeightField::from_scene(s);
+  const StampSchedule sch = make_schedule(s.tool, s.stroke, [&](const Vec2& p) { return f(p); });
+  Raster plane = Raster::covering(s.domain.box(), s.output.raster_m);
+  for (std::size_t iy = 0; iy < plane.ny; ++iy)
+    for (std::size_t ix = 0; ix < plane.nx; ++ix) plane.at(ix, iy) = f(plane.point(ix, iy));
+  const auto m = accuracy_metrics(s, sch, f, plane, plane);
+  EXPECT_NEAR(m["plane.slope_deg"].get<double>(), 30.0, 1e-9);
+  EXPECT_NEAR(m["plane.slope_error_deg"].get<double>(), 0.0, 1e-9);
+  EXPECT_NEAR(m["plane.azimuth_deg"].get<double>(), 67.5, 1e-9);
+  EXPECT_NEAR(m["plane.rms_m"].get<double>(), 0.0, 1e-12);
+  EXPECT_NEAR(m["plane.slope_mean_deg"].get<double>(), 30.0, 1e-9);
+  EXPECT_NEAR(m["plane.slope_max_deg"].get<double>(), 30.0, 1e-9);
+
+  Raster stepped = plane;  // a 2 mm step down where x crosses the centre
+  for (std::size_t iy = 0; iy < stepped.ny; ++iy)
+    for (std::size_t ix = 0; ix < stepped.nx; ++ix)
+      if (stepped.point(ix, iy).x() > 0.1) stepped.at(ix, iy) -= 0.002;
+  const PlaneShape p = measure_plane(stepped);
+  EXPECT_NEAR(p.slope_deg, 30.0, 1.5);
+  EXPECT_NEAR(p.slope_mean_deg, 30.0, 1.5);
+  EXPECT_GT(p.slope_max_deg, 35.0);
+}
+
 }  // namespace
 }  // namespace sb
