@@ -94,14 +94,15 @@ def run(ctx):
     rows = []
     for (case, az, cfg, rule), r in s.items():
         if case == "pile":
-            rows.append([case, az, cfg, rule, r["pile.flank_angle_deg"], "", "", "", abs(r["pile.flank_angle_deg"] - CRITICAL),
-                         r["pile.roundness"], r["step_ms.p50"], r["volume_drift_rel"]])
+            flank = r["pile.flank_angle_deg"]
+            rows.append([case, az, cfg, rule, flank, "", "", "", abs(flank - CRITICAL), r["pile.roundness"],
+                         r["step_ms.p50"], r["volume_drift_rel"]])
             continue
         mean_k, max_k, min_k, spread_k, worst_k = CASES[case][1]
         if case == "plane":  # the fitted plane's slope where the others have their gentlest section
             worst = max(abs(r["plane.slope_deg"] - CRITICAL), abs(r[max_k] - CRITICAL))
-            rows.append([case, az, cfg, rule, r[mean_k], r[max_k], r["plane.slope_deg"], "", worst, "", r["step_ms.p50"],
-                         r["volume_drift_rel"]])
+            rows.append([case, az, cfg, rule, r[mean_k], r[max_k], r["plane.slope_deg"], "", worst, "",
+                         r["step_ms.p50"], r["volume_drift_rel"]])
         else:
             rows.append([case, az, cfg, rule, r[mean_k], r[max_k], r[min_k], r[spread_k], r[worst_k], "",
                          r["step_ms.p50"], r["volume_drift_rel"]])
@@ -204,8 +205,8 @@ plane, with the azimuth where it occurs; the steepest local slope on the plane; 
 - Edge rule: the trench's mean wall angle is off by up to {span('edge', 2):.2f} degrees and one section by up to
   {span('edge', 4):.2f}; the tilted plane rests up to {span('edge', 8):.2f} degrees too steep. The rule tests slopes
   along neighbour directions only, so a surface whose downhill direction falls between them stands steeper.
-- Gradient rule: {span('gradient', 2):.2f} and {span('gradient', 4):.2f} degrees on the trench, {span('gradient', 8):.2f}
-  on the plane.
+- Gradient rule: {span('gradient', 2):.2f} and {span('gradient', 4):.2f} degrees on the trench,
+  {span('gradient', 8):.2f} on the plane.
 - Issue 10's bar (trench mean within 0.3 degree and every section within 0.6 at every azimuth, pile flank
   within 0.5, roundness at most 0.02 on the TIN and the 8-neighbour grid): met by
   {', '.join(f'{c} with the {rule} rule' for rule in RULES for c in meets[rule]) or 'no model'}.
