@@ -29,8 +29,8 @@ CASES = {
 }
 TRENCH_ALL = [0, 10, 22.5, 30, 45, 60, 67.5, 80, 90]
 # Per profile: case -> (azimuths in degrees, configurations). The tiny profile (tests) runs 18
-# runs of under a second each; the paper profile 144, about 2 CPU-minutes (the TIN planes are
-# the longest, about 5 s each).
+# runs of under a second each; the paper profile 144, 40 CPU-seconds measured (the TIN planes
+# are the longest, about 2 CPU-s each; 2 minutes wall with 2 workers on a loaded 2-core machine).
 PLAN = {
     "tiny": {"trench": ([0, 22.5], ["tin", "grid 8-nb"]), "ridge": ([22.5], ["tin", "grid 8-nb"]),
              "plane": ([22.5], ["grid 8-nb"]), "pile": ([0], ["tin", "grid 8-nb"])},
@@ -39,7 +39,7 @@ PLAN = {
     "full": {"trench": (sorted(set(range(0, 91, 5)) | {22.5, 67.5}), list(CONFIGS)),
              "ridge": (TRENCH_ALL, list(CONFIGS)), "plane": (TRENCH_ALL, list(CONFIGS)), "pile": ([0], list(CONFIGS))},
 }
-COST = {"tiny": "seconds", "paper": "about 2 CPU-minutes", "full": "about 5 CPU-minutes"}
+COST = {"tiny": "a few CPU-seconds", "paper": "about 40 CPU-seconds", "full": "about 2 CPU-minutes"}
 CENTRE = 0.15  # trench_azimuth.toml and ridge.toml: a 0.3 m square
 
 
