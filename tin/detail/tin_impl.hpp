@@ -178,6 +178,9 @@ class TinTerrain final : public Terrain {
   // Unconstrains every edge of a generation older than `generation` and returns the volume
   // change of the flips (the stamp's deposit gives it back); O(constrained edges + region).
   double drop_stale_constraints(std::uint32_t generation);
+  // Moves the points of a clipped contour that lie on the domain's border onto an existing
+  // border vertex within `reach` on the same side, if there is one. O(points x vertices near).
+  void snap_border_crossings(std::vector<Vec2>& contour, double reach);
   double stale_delta_ = 0.0;  // the current stamp's share of that change
   // erosion.cpp: splits edge (a, b) at its middle (volume change measured, and compensated
   // under tin.conserve_volume); returns the vertex there.
