@@ -187,6 +187,15 @@ def run(ctx):
         return max(vals) if vals else float("nan")
 
     meets = {rule: [r[0] for r in worst_rows if r[1] == rule and r[-1] == "yes"] for rule in RULES}
+    # Where a rule leaves a surface flatter than critical by more than half a degree (pile, plane).
+    flat = sorted({f"{cfg} {rule} ({case} {s[k][key]:.2f}{'' if case == 'pile' else f' at {az:g} deg'})" for k in s
+                   for case, az, cfg, rule in [k] for c, key in (("pile", "pile.flank_angle_deg"),
+                                                                  ("plane", "plane.slope_deg"))
+                   if case == c and s[k][key] < CRITICAL - 0.5})
+    still = [f"{cfg} at {az:g} deg" for case, az, cfg, rule in s if case == "plane" and rule == "edge"
+             and s[(case, az, cfg, rule)]["plane.slope_deg"] > CRITICAL + 4.9]
+    still_text = ("\n  A 35-degree plane that does not move at all: " + ", ".join(still) + " (along every stencil "
+                  "direction it is less steep than critical: atan(tan 35 cos 45) = 26.3 degrees)." if still else "")
     return f"""## Accuracy at any orientation: trench, ridge, plane and pile, both erosion rules
 
 Each case is turned through the azimuths below and run with both rules (`erosion.rule = "edge"`, the
@@ -204,9 +213,10 @@ plane, with the azimuth where it occurs; the steepest local slope on the plane; 
 {worst_md}
 - Edge rule: the trench's mean wall angle is off by up to {span('edge', 2):.2f} degrees and one section by up to
   {span('edge', 4):.2f}; the tilted plane rests up to {span('edge', 8):.2f} degrees too steep. The rule tests slopes
-  along neighbour directions only, so a surface whose downhill direction falls between them stands steeper.
+  along neighbour directions only, so a surface whose downhill direction falls between them stands steeper.{still_text}
 - Gradient rule: {span('gradient', 2):.2f} and {span('gradient', 4):.2f} degrees on the trench,
   {span('gradient', 8):.2f} on the plane.
+- Flatter than critical by more than half a degree: {"; ".join(flat) or "none"}.
 - Issue 10's bar (trench mean within 0.3 degree and every section within 0.6 at every azimuth, pile flank
   within 0.5, roundness at most 0.02 on the TIN and the 8-neighbour grid): met by
   {', '.join(f'{c} with the {rule} rule' for rule in RULES for c in meets[rule]) or 'no model'}.
