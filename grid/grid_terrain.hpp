@@ -9,10 +9,12 @@
 // (grid_stamp.hpp); erosion applies sb::erosion_transfers over an active set with an
 // 8- or 4-neighbour stencil (erosion_kernel.hpp, active_set.hpp).
 //
-// Memory per node: sizeof(Real) for the height + 2 for the active-set state, i.e.
+// Memory per node: sizeof(Real) for the height + 2 for the active-set state (idle count,
+// and 1 bit of membership), i.e.
 //   double: 10 bytes/node,  float: 6 bytes/node,
-// plus 8 bytes per active node (two index lists, at their high-water mark) and, once erosion
-// has run, its node-class tables (at most 25 classes, < 8 kB). A 512 x 512 grid is 2.6 MB
+// plus, once erosion has run, its node-class tables (at most 25 classes, < 16 kB), and
+// during a dense pass a scratch of 8 bytes per node of a row and 1 bit per node of the rows
+// it visits. A 512 x 512 grid is 2.6 MB
 // in double, 1.6 MB in float.
 // Volume drift after 1000 stamps with erosion (a disk tool over flat sand, measured in
 // tests/unit/grid_volume_test.cpp): double 0, float 1.4e-16 relative -- both at the
@@ -27,25 +29,39 @@
 //   sample(raster)              O(raster points)
 //   stamp                       O(w), plus O(v) per node near the footprint's boundary
 //                               or in the rim band; pour O(nodes within its radius)
-//   erode                       O(passes * a * stencil); never the whole grid
+//   erode                       O(passes * a * stencil) on the active set, or per dense
+//                               pass O(nodes between the first and last member of each
+//                               row), the stable ones classed with vector arithmetic;
+//                               never the whole grid unless every row is active
 //                               (erosion_kernel.hpp: node-class tables, built once per rule)
-//   simplify                    O(1), nothing to simplify on a grid
+//   simplify                    O(1), nothing to simplify on a grid (reports a zero change)
 //   volume, max_slope_deg,
 //   mesh, check                 O(n)
 //   stream_mesh                 O(n) time, O(nx) memory (the run file's writer)
 //   stats                       O(1)
 // Each stamp and erode reports its exact volume change (volume_change_m3: the stamp's own
 // sums, and the rounding carry), so the runner never integrates the grid per step.
-// Measured (tests/bench/grid_bench.cpp, one shared core of a loaded 2-vCPU VM, CPU time,
-// medians of 5, main and this kernel interleaved): erosion 23 M node updates/s on the pile
-// and stroke states in double (main: 22-24 M/s, unchanged: the visits of a scattered active
-// set wait on memory, not on arithmetic), 22 M/s with every node of 2048^2 active against
-// 18 M/s for the plain scalar reference sweep (BM_ReferenceSweep, 1.2x); a stamp ~80 ns per
-// node of its window, e.g. 3 ms for a 64-cell (32 cm) disk.
+// Measured (tests/bench/grid_bench.cpp, a loaded 2-vCPU VM, CPU time, medians of 3 runs of
+// 3 repetitions, main and this kernel interleaved), node updates per second (one update =
+// the rule evaluated at one node) and time per call of 64 passes:
+//                        main               this kernel (dense pass over the row spans)
+//   pile,   double       23.5 M/s  3.16 ms  36.6 M/s  2.04 ms
+//   stroke, double       26.6 M/s  8.48 ms  52.8 M/s  4.64 ms
+//   pile,   float        19.6 M/s  3.80 ms  30.2 M/s  2.47 ms
+//   stroke, float        21.9 M/s 10.28 ms  42.3 M/s  5.78 ms
+// 2048^2 with every node active (steep dunes, 46 % of the nodes above the critical angle):
+// 78 M/s in double, 61 M/s in float, against 16.0 and 15.5 M/s for the plain scalar
+// reference sweep of the same rule in the same run (BM_ReferenceSweep): 4.9x and 3.9x.
+// On these states most visited nodes transfer, and a transferring visit costs ~180
+// instructions (8 neighbours); the vector classing only saves the visits of stable nodes.
+// A stamp ~80 ns per node of its window, e.g. 3 ms for a 64-cell (32 cm) disk.
 // Settling (relax_at_end) is diffusive near the critical angle: on flat_stroke.toml the
 // passes to settle grow 3.4-3.8x per halving of the cell (163, 552, 2077 at 2.5, 1.25,
-// 0.625 mm), the settling updates ~16x; neither a larger transfer fraction (1.9: 49, 157, 537
-// passes) nor index-ordered sweeps change that exponent. See README, "Grid erosion".
+// 0.625 mm); neither a larger transfer fraction (1.9: 49, 157, 537 passes) nor the ordered
+// or dense sweeps change that exponent, they only make each pass cheaper: stroke and settling
+// of flat_stroke.toml take 0.061, 0.72 and 9.9 s at 0.32, 1.3 and 5.1 M nodes (main: 0.115,
+// 1.25, 19.4 s; medians of 2, interleaved), time growing as n^1.8. See README, "The three
+// back-ends at a glance".
 #include <functional>
 #include <memory>
 #include <optional>
@@ -82,7 +98,7 @@ class GridTerrain final : public Terrain {
   double max_slope_deg() const override;
 
   // For tests and benchmarks: every node a member of the active set; which sweep erosion
-  // runs (default Auto: the dense pass when at least an eighth of the nodes are members).
+  // runs (default Auto: the dense pass when the members fill an eighth of their row spans).
   void activate_all() { active_.activate_all(); }
   void set_sweep_path(SweepPath path) { sweep_path_ = path; }
   const GridLayout& layout() const { return grid_.layout(); }

@@ -18,6 +18,10 @@
 // the dense grid: flat_stroke 35 KB (0.16), pile 30 KB (0.19), trench 58 KB (0.39: a
 // quarter of its nodes are disturbed), dunes, where every node differs, 166 KB (0.95).
 //
+// Each stamp and erode reports its exact volume change (volume_change_m3: the stamp's own
+// sums and the rounding carry, as on the dense grid), so the runner never integrates it per
+// step. The dense erosion pass visits every node of its spans here (no contiguous rows to
+// class with vector arithmetic), with the same heights as the dense grid's, bit for bit.
 // Costs: those of GridTerrain (grid_terrain.hpp), each height read or write O(1) through
 // the block table (a multiply-high for the row, a few shifts, two loads; a write one branch
 // more), a write to a uniform block O(64) once to create its leaf; when erosion settles
@@ -61,7 +65,7 @@ class SparseGridTerrain final : public Terrain {
   double max_slope_deg() const override;
 
   // For tests and benchmarks: every node a member of the active set; which sweep erosion
-  // runs (default Auto: the dense pass when at least an eighth of the nodes are members).
+  // runs (default Auto: the dense pass when the members fill an eighth of their row spans).
   void activate_all() { active_.activate_all(); }
   void set_sweep_path(SweepPath path) { sweep_path_ = path; }
   const GridLayout& layout() const { return heights_.layout(); }
