@@ -131,30 +131,42 @@ double dunes(const sb::Vec2& p) {
   return kSand + 0.0625 * std::sin(k * p.x()) * std::cos(0.7 * k * p.y());
 }
 
+GridLayout big_layout() { return GridLayout::covering({{0.0, 0.0}, {kBigSize, kBigSize}}, kCell); }
+
 template <class Real>
 GridTerrain<Real> all_active() {
-  const GridLayout layout = GridLayout::covering({{0.0, 0.0}, {kBigSize, kBigSize}}, kCell);
-  GridTerrain<Real> t(layout, dunes, 8, 2);
+  GridTerrain<Real> t(big_layout(), dunes, 8, 2);
   t.activate_all();
   return t;
 }
 
-template <class Real>
-void BM_AllActive(benchmark::State& state) {
+// state.range(0) passes over a fresh (untimed) copy of the all-active state per iteration:
+// copy(start) makes the copy, run(copy, passes, rule) erodes it and returns the updates.
+template <class Real, class Copy, class Run>
+void time_all_active(benchmark::State& state, Copy&& copy, Run&& run) {
   const int passes = static_cast<int>(state.range(0));
   const GridTerrain<Real> start = all_active<Real>();
   const sb::ErosionRule r = rule();
   double updates = 0;
   for (auto _ : state) {
     state.PauseTiming();
-    GridTerrain<Real> t = start;
+    auto fresh = copy(start);
     state.ResumeTiming();
-    const sb::ErosionReport report = t.erode(r, {.max_passes = passes});
-    benchmark::DoNotOptimize(report);
-    updates += static_cast<double>(report.updates);
+    updates += static_cast<double>(run(fresh, passes, r));
   }
   state.counters["updates_per_s"] = benchmark::Counter(updates, benchmark::Counter::kIsRate);
   state.counters["updates_per_call"] = benchmark::Counter(updates, benchmark::Counter::kAvgIterations);
+}
+
+template <class Real>
+void BM_AllActive(benchmark::State& state) {
+  time_all_active<Real>(
+      state, [](const GridTerrain<Real>& start) { return start; },
+      [](GridTerrain<Real>& t, int passes, const sb::ErosionRule& r) {
+        const sb::ErosionReport report = t.erode(r, {.max_passes = passes});
+        benchmark::DoNotOptimize(report);
+        return report.updates;
+      });
 }
 BENCHMARK(BM_AllActive<float>)->Name("BM_AllActive<float>")->ArgName("passes")->Arg(4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_AllActive<double>)->Name("BM_AllActive<double>")->ArgName("passes")->Arg(4)->Unit(benchmark::kMillisecond);
@@ -191,20 +203,14 @@ void reference_pass(std::vector<Real>& z, const GridLayout& g, const sb::Erosion
 
 template <class Real>
 void BM_ReferenceSweep(benchmark::State& state) {
-  const int passes = static_cast<int>(state.range(0));
-  const GridTerrain<Real> start = all_active<Real>();
-  const sb::ErosionRule r = rule();
-  double updates = 0;
-  for (auto _ : state) {
-    state.PauseTiming();
-    std::vector<Real> z = start.heights().heights();
-    state.ResumeTiming();
-    for (int p = 0; p < passes; ++p) reference_pass(z, start.layout(), r);
-    benchmark::DoNotOptimize(z.data());
-    updates += static_cast<double>(passes) * static_cast<double>(start.layout().nodes());
-  }
-  state.counters["updates_per_s"] = benchmark::Counter(updates, benchmark::Counter::kIsRate);
-  state.counters["updates_per_call"] = benchmark::Counter(updates, benchmark::Counter::kAvgIterations);
+  const GridLayout layout = big_layout();
+  time_all_active<Real>(
+      state, [](const GridTerrain<Real>& start) { return start.heights().heights(); },
+      [&layout](std::vector<Real>& z, int passes, const sb::ErosionRule& r) {
+        for (int p = 0; p < passes; ++p) reference_pass(z, layout, r);
+        benchmark::DoNotOptimize(z.data());
+        return static_cast<std::size_t>(passes) * layout.nodes();
+      });
 }
 BENCHMARK(BM_ReferenceSweep<float>)
     ->Name("BM_ReferenceSweep<float>")
