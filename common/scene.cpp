@@ -346,7 +346,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   s.erosion.relax_at_end = f.boolean("erosion.relax_at_end", true);
   s.erosion.relax_max_passes = static_cast<int>(f.integer("erosion.relax_max_passes", 20000, 0, 100000000));
   s.erosion.rule = f.choice("erosion.rule", "gradient", {"gradient", "edge"}) == "gradient" ? ErosionRuleKind::Gradient
-                                                                                        : ErosionRuleKind::Edge;
+                                                                                            : ErosionRuleKind::Edge;
 
   // [tool]
   const std::string shape = f.choice("tool.shape", "disk", {"disk", "box", "ellipse", "polygon", "pour"});
