@@ -164,6 +164,26 @@ double TinTerrain::drop_stale_constraints(std::uint32_t generation) {
   return measured.delta();
 }
 
+void TinTerrain::snap_border_crossings(std::vector<Vec2>& contour, double reach) {
+  const auto on_side = [this](const Vec2& p, int axis) { return p[axis] == box_.lo[axis] || p[axis] == box_.hi[axis]; };
+  std::vector<VertexHandle> near;
+  for (Vec2& p : contour) {
+    for (int axis = 0; axis < 2; ++axis) {
+      if (!on_side(p, axis) || on_side(p, 1 - axis)) continue;  // not on this side, or a corner
+      collect_vertices(Aabb2{p, p}.expanded(reach), near);
+      double best = reach;
+      for (VertexHandle v : near) {
+        const Vec2 q = xy(v);
+        const double d = std::abs(q[1 - axis] - p[1 - axis]);
+        if (q[axis] == p[axis] && d > 0.0 && d <= best) {
+          best = d;
+          p[1 - axis] = q[1 - axis];
+        }
+      }
+    }
+  }
+}
+
 StampReport TinTerrain::stamp(const ToolStamp& s) {
   // The constraints of stamps that have passed only kept their walls from being flipped:
   // dropped, so the surface between old stamps is free to relax and coarsen (the Delaunay
@@ -216,6 +236,14 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   }
   std::vector<Vec2> outer_clip = clip_to_box(outer, box_);
   std::vector<Vec2> inner_clip = clip_to_box(footprint, box_);
+  // Where the contours cross the border, stamps that follow each other along a stroke leave
+  // border vertices at arbitrary distances. A border vertex a hair from the next has a tiny
+  // area, which throttles every transfer through it (a transfer is limited by the smaller
+  // area), so the slopes there settled only after millions of passes. A crossing within a
+  // quarter gap of an existing border vertex takes that vertex's place instead; O and I,
+  // at least a gap apart along the border, stay apart.
+  snap_border_crossings(outer_clip, 0.25 * gap);
+  snap_border_crossings(inner_clip, 0.25 * gap);
   drop_near_duplicates(outer_clip, 2.0 * snap + tiny);
   drop_near_duplicates(inner_clip, 2.0 * snap + tiny);
   if (outer_clip.size() < 3 || !(std::abs(signed_area(outer_clip)) > 0.0)) return report;  // off the domain
