@@ -120,7 +120,11 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
           if (transfer_scratch_[k] <= 0.0 || nbr_scratch_[k].area <= 0.0) continue;
           const VertexHandle w = vertex_scratch_[k];
           set_z(w, w->point().z() + transfer_scratch_[k] / nbr_scratch_[k].area);
-          touch(w);
+          // The gradient rule reads w's height in its neighbours' fan gradients too.
+          if (rule.needs_gradient())
+            touch_with_neighbours(w);
+          else
+            touch(w);
           add_to_simplify(w);
           ++report.transfers;
         }
