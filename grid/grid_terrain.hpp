@@ -58,10 +58,11 @@
 // Settling (relax_at_end) is diffusive near the critical angle: on flat_stroke.toml the
 // passes to settle grow 3.4-3.8x per halving of the cell (163, 552, 2077 at 2.5, 1.25,
 // 0.625 mm); neither a larger transfer fraction (1.9: 49, 157, 537 passes) nor the ordered
-// or dense sweeps change that exponent, they only make each pass cheaper: stroke and settling
-// of flat_stroke.toml take 0.061, 0.72 and 9.9 s at 0.32, 1.3 and 5.1 M nodes (main: 0.115,
-// 1.25, 19.4 s; medians of 2, interleaved), time growing as n^1.8. See README, "The three
-// back-ends at a glance".
+// or dense sweeps change that exponent, they only make each pass cheaper. Stroke and
+// settling of flat_stroke.toml at 0.32, 1.3 and 5.1 M nodes (one interleaved run with main,
+// loaded VM): edge rule 0.070, 0.98, 14.8 s (main 0.127, 1.92, 27.4 s), gradient rule 0.142,
+// 3.08, 44.9 s (main 0.175, 2.79, 63.6 s): time grows as n^1.9 (edge) to n^2.1 (gradient).
+// See README, "The three back-ends at a glance".
 #include <functional>
 #include <memory>
 #include <optional>
