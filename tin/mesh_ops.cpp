@@ -364,7 +364,9 @@ Capture TinTerrain::begin_capture(const Aabb2& box) {
     }
   }
   c.faces = face_scratch_.size();
-  std::sort(c.outer.begin(), c.outer.end(), [](const OuterFace& x, const OuterFace& y) { return &*x.face < &*y.face; });
+  c.outer_index.reserve(c.outer.size());
+  for (const OuterFace& o : c.outer) c.outer_index.push_back(&*o.face);
+  std::sort(c.outer_index.begin(), c.outer_index.end());
   return c;
 }
 
@@ -372,12 +374,10 @@ CaptureResult TinTerrain::end_capture(Capture& c, std::vector<VertexHandle>* reg
   CaptureResult r;
   r.volume_before = c.volume;
   r.area_before = c.area;
-  auto is_outer = [&c](FaceHandle f) {
-    const auto it = std::lower_bound(c.outer.begin(), c.outer.end(), &*f,
-                                     [](const OuterFace& o, const void* p) { return &*o.face < p; });
-    return it != c.outer.end() && &*it->face == &*f;
-  };
-  // The outer faces must have survived unchanged; then they fence in the same area.
+  auto is_outer = [&c](FaceHandle f) { return std::binary_search(c.outer_index.begin(), c.outer_index.end(), &*f); };
+  // The outer faces must have survived unchanged; then they fence in the same area. The walk
+  // over the region after starts from the first of them in discovery order, so the order of
+  // the region's vertices (and of the erosion list they join) does not depend on addresses.
   bool intact = true;
   FaceHandle start;
   for (const OuterFace& o : c.outer) {

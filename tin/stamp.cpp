@@ -77,6 +77,26 @@ double TinTerrain::drop_stale_constraints(std::uint32_t generation) {
   return measured.delta();
 }
 
+void TinTerrain::snap_border_crossings(std::vector<Vec2>& contour, double reach) {
+  const auto on_side = [this](const Vec2& p, int axis) { return p[axis] == box_.lo[axis] || p[axis] == box_.hi[axis]; };
+  std::vector<VertexHandle> near;
+  for (Vec2& p : contour) {
+    for (int axis = 0; axis < 2; ++axis) {
+      if (!on_side(p, axis) || on_side(p, 1 - axis)) continue;  // not on this side, or a corner
+      collect_vertices(Aabb2{p, p}.expanded(reach), near);
+      double best = reach;
+      for (VertexHandle v : near) {
+        const Vec2 q = xy(v);
+        const double d = std::abs(q[1 - axis] - p[1 - axis]);
+        if (q[axis] == p[axis] && d > 0.0 && d <= best) {
+          best = d;
+          p[1 - axis] = q[1 - axis];
+        }
+      }
+    }
+  }
+}
+
 StampReport TinTerrain::stamp(const ToolStamp& s) {
   // The constraints of stamps that have passed only kept their walls from being flipped:
   // dropped, so the surface between old stamps is free to relax and coarsen (the Delaunay
@@ -117,7 +137,7 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   return report;
 }
 
-bool TinTerrain::plan_stamp(const ToolStamp& s, StampWork& w) const {
+bool TinTerrain::plan_stamp(const ToolStamp& s, StampWork& w) {
   if (s.footprint.size() < 3) throw InputError("stamp: the footprint needs at least 3 points");
   for (const Vec2& p : s.footprint)
     if (!p.allFinite()) throw InputError("stamp: the footprint has a non-finite point");
@@ -156,6 +176,14 @@ bool TinTerrain::plan_stamp(const ToolStamp& s, StampWork& w) const {
   }
   w.outer_clip = clip_to_box(w.outer, box_);
   w.inner_clip = clip_to_box(footprint, box_);
+  // Where the contours cross the border, stamps that follow each other along a stroke leave
+  // border vertices at arbitrary distances. A border vertex a hair from the next has a tiny
+  // area, which throttles every transfer through it (a transfer is limited by the smaller
+  // area), so the slopes there settled only after millions of passes. A crossing within a
+  // quarter gap of an existing border vertex takes that vertex's place instead; O and I,
+  // at least a gap apart along the border, stay apart.
+  snap_border_crossings(w.outer_clip, 0.25 * w.gap);
+  snap_border_crossings(w.inner_clip, 0.25 * w.gap);
   drop_near_duplicates(w.outer_clip, 2.0 * snap + w.tiny);
   drop_near_duplicates(w.inner_clip, 2.0 * snap + w.tiny);
   if (w.outer_clip.size() < 3 || !(std::abs(signed_area(w.outer_clip)) > 0.0)) return false;

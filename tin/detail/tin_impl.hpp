@@ -98,8 +98,11 @@ struct OuterFace {
   int toward = 0;           // index of the neighbour inside the region
 };
 struct Capture {
-  std::vector<OuterFace> outer;  // finite faces just outside the region, sorted by address
-  double volume = 0.0;           // integral of z over the region before
+  std::vector<OuterFace> outer;  // finite faces just outside the region, in discovery order
+  // Their addresses, sorted: for membership tests only (never iterated, because addresses
+  // differ between processes and so must not decide anything a run computes).
+  std::vector<const void*> outer_index;
+  double volume = 0.0;  // integral of z over the region before
   double area = 0.0;
   std::size_t faces = 0;
 };
@@ -175,7 +178,7 @@ class TinTerrain final : public Terrain {
   // stamp.cpp: the paper's steps 1a-1f, in the order stamp() takes them.
   // The footprint made ready (checked, cut to what the mesh resolves), the contours O and I
   // clipped to the domain; false when O misses the domain.
-  bool plan_stamp(const ToolStamp& s, StampWork& w) const;
+  bool plan_stamp(const ToolStamp& s, StampWork& w);
   void contour_points(StampWork& w) const;   // 1a: O's heights, I, interior and rim points
   void find_constraints_near(StampWork& w);  // old constraints within reach of O (w.dropped)
   // The stamp's vertices inserted; old ones between I and O (and just outside O) removed.
@@ -195,6 +198,9 @@ class TinTerrain final : public Terrain {
   // Unconstrains every edge of a generation older than `generation` and returns the volume
   // change of the flips (the stamp's deposit gives it back); O(constrained edges + region).
   double drop_stale_constraints(std::uint32_t generation);
+  // Moves the points of a clipped contour that lie on the domain's border onto an existing
+  // border vertex within `reach` on the same side, if there is one. O(points x vertices near).
+  void snap_border_crossings(std::vector<Vec2>& contour, double reach);
   double stale_delta_ = 0.0;  // the current stamp's share of that change
   // erosion.cpp: splits edge (a, b) at its middle (volume change measured, and compensated
   // under tin.conserve_volume); returns the vertex there.

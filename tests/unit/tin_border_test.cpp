@@ -1,0 +1,46 @@
+// Stamps that cross the domain's border, one after another along a stroke: their contours
+// meet the border at new points each time. Left at arbitrary distances, two border vertices a
+// hair apart had tiny areas that throttled every transfer through them, and the stroke
+// leaving the domain in the stability matrix never settled (44.7 degrees after 20000 passes).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <vector>
+
+#include "tin_test_support.hpp"
+
+namespace sb::tin::test {
+namespace {
+
+// The stroke runs out of the 0.5 m domain at x = 0.5 with stamps every 2.5 mm.
+const std::vector<std::string> kLeaving = {"stroke.path_m=[[0.3, 0.25], [0.6, 0.25]]", "stroke.spacing_m=0.0025"};
+
+TEST(TinBorder, AStrokeLeavingTheDomainSettles) {
+  const Scene s = scene(kFlatScene, kLeaving);  // the default rule
+  auto t = make(s);
+  for (const ToolStamp& st : schedule_of(s).stamps) step(*t, s, st);
+  EXPECT_TRUE(relax(*t, s, 20000));
+  SB_EXPECT_TIN_OK(*t);
+  EXPECT_LT(t->max_slope_deg(), s.material.critical_angle_deg + s.erosion.settle_tolerance_deg + 1e-6);
+}
+
+TEST(TinBorder, CrossingsDoNotCrowdTheBorder) {
+  const Scene s = scene(kFlatScene, kLeaving);
+  auto t = make(s);
+  for (const ToolStamp& st : schedule_of(s).stamps) step(*t, s, st);
+  // The border x = 0.5 between the stroke's crossings: neighbouring vertices on it.
+  std::vector<double> ys;
+  for (const Vec3& v : t->mesh().vertices)
+    if (v.x() == 0.5) ys.push_back(v.y());
+  std::sort(ys.begin(), ys.end());
+  ASSERT_GT(ys.size(), 4u);
+  double closest = 1.0;
+  for (std::size_t i = 1; i < ys.size(); ++i) closest = std::min(closest, ys[i] - ys[i - 1]);
+  // The contour gap is 5 % of the 2 cm radius (1 mm); crossings snap within a quarter of it.
+  EXPECT_GT(closest, 0.25e-3 * 0.99);
+}
+
+}  // namespace
+}  // namespace sb::tin::test
