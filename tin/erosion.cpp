@@ -111,7 +111,9 @@ ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& bu
         set_z(v, v->point().z() - total / area);
         // One ring: v fell, so its neighbours' drops towards v grew; a receiver rose, which
         // only its own drops grow (its neighbours' drops towards it shrank).
-        touch_with_neighbours(v);
+        // (vertex_scratch_ holds v's neighbours: no second circulation.)
+        touch(v);
+        for (VertexHandle w : vertex_scratch_) touch(w);
         add_to_simplify(v);
         for (std::size_t k = 0; k < nbr_scratch_.size(); ++k) {
           if (transfer_scratch_[k] <= 0.0 || nbr_scratch_[k].area <= 0.0) continue;

@@ -189,6 +189,10 @@ bool TinTerrain::plan_stamp(const ToolStamp& s, StampWork& w) {
   if (w.outer_clip.size() < 3 || !(std::abs(signed_area(w.outer_clip)) > 0.0)) return false;
   if (w.inner_clip.size() < 3 || !(std::abs(signed_area(w.inner_clip)) > 0.0)) w.inner_clip.clear();
   w.footprint_bounds = bounds(footprint).expanded(2.0 * w.tiny);
+  const Vec2 centre = w.tool.pose.xy;
+  if (w.tool.contains(centre)) w.inside_radius = distance_to_boundary(footprint, centre) - 2.0 * w.tiny;
+  for (const Vec2& p : footprint) w.reach_radius = std::max(w.reach_radius, (p - centre).norm());
+  w.reach_radius += std::max(w.tool.rim.width_m, 0.0) + 2.0 * w.tiny;
   return true;
 }
 

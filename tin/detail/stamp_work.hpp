@@ -25,6 +25,9 @@ struct StampWork {
   std::vector<Vec2> outer;                   // O, unclipped
   std::vector<Vec2> outer_clip, inner_clip;  // O and I clipped to the domain (I empty: off it)
   Aabb2 footprint_bounds;
+  // Around the pose: points nearer than `inside_radius` are in the footprint, points farther
+  // than `reach_radius` beyond the rim band (cheap tests before the polygon's O(corners) ones).
+  double inside_radius = 0.0, reach_radius = 0.0;
 
   // 1a: the points to insert, with their heights from the terrain.
   std::vector<ContourPoint> o_pts, i_pts, interior_pts, rim_pts;
@@ -45,7 +48,11 @@ struct StampWork {
   }
   // The deposit's weight: 0 inside the footprint (the inner contour lies on its boundary,
   // which point-in-polygon may put either side, so it is excluded explicitly).
-  double rim_weight(const Vec2& p) const { return in_footprint(p) ? 0.0 : tool.rim_weight(p); }
+  double rim_weight(const Vec2& p) const {
+    const double d2 = (p - tool.pose.xy).squaredNorm();
+    if (d2 < inside_radius * inside_radius || d2 > reach_radius * reach_radius) return 0.0;
+    return in_footprint(p) ? 0.0 : tool.rim_weight(p);
+  }
   // A tool deeper than the bed stops at its floor, z = 0: there is no sand below to push away.
   double bottom(const Vec2& p) const { return std::max(tool.bottom_z(p), 0.0); }
   bool is_own(VertexHandle v) const { return std::binary_search(own.begin(), own.end(), &*v); }
