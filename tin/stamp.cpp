@@ -190,7 +190,7 @@ bool TinTerrain::plan_stamp(const ToolStamp& s, StampWork& w) {
   if (w.inner_clip.size() < 3 || !(std::abs(signed_area(w.inner_clip)) > 0.0)) w.inner_clip.clear();
   w.footprint_bounds = bounds(footprint).expanded(2.0 * w.tiny);
   const Vec2 centre = w.tool.pose.xy;
-  if (w.tool.contains(centre)) w.inside_radius = distance_to_boundary(footprint, centre) - 2.0 * w.tiny;
+  if (w.tool.contains(centre)) w.inside_radius = std::max(0.0, distance_to_boundary(footprint, centre) - 2.0 * w.tiny);
   for (const Vec2& p : footprint) w.reach_radius = std::max(w.reach_radius, (p - centre).norm());
   w.reach_radius += std::max(w.tool.rim.width_m, 0.0) + 2.0 * w.tiny;
   return true;
@@ -387,8 +387,8 @@ void TinTerrain::remove_redundant(StampWork& w, StampReport& report) {
   std::vector<VertexHandle> redundant;
   for (VertexHandle v : w.inside) {
     const Vec2 p = xy(v);
-    if (w.is_own(v) || v->info().border || distance_to_boundary(s.footprint, p) <= w.tiny || has_constraints(v))
-      continue;
+    if (w.is_own(v) || v->info().border || has_constraints(v)) continue;
+    if (!w.deep_inside(p) && distance_to_boundary(s.footprint, p) <= w.tiny) continue;
     if (std::abs(v->point().z() - w.bottom(p)) > level_eps) continue;
     bool deeper = false;
     auto c = cdt_.incident_vertices(v), done = c;

@@ -43,8 +43,11 @@ struct StampWork {
   std::vector<VertexHandle> changed;                           // heights changed (lowered or raised)
   double lowered_volume = 0.0;                                 // taken out by 1d
 
+  // Strictly inside, off the boundary (the inscribed circle's test, O(1)).
+  bool deep_inside(const Vec2& p) const { return (p - tool.pose.xy).squaredNorm() < inside_radius * inside_radius; }
   bool in_footprint(const Vec2& p) const {
-    return footprint_bounds.contains(p) && (tool.contains(p) || distance_to_boundary(tool.footprint, p) <= tiny);
+    return deep_inside(p) ||
+           (footprint_bounds.contains(p) && (tool.contains(p) || distance_to_boundary(tool.footprint, p) <= tiny));
   }
   // The deposit's weight: 0 inside the footprint (the inner contour lies on its boundary,
   // which point-in-polygon may put either side, so it is excluded explicitly).
