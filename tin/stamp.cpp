@@ -202,9 +202,14 @@ void TinTerrain::contour_points(StampWork& w) const {
   const double snap = spec_.snap_m, tiny = w.tiny;
   const double step = spec_.contour_subdivision_m;
   const double tol = spec_.tolerance_m;
+  // Pieces no shorter than the gap between O and I: finer O vertices (where O crosses an old
+  // stamp's steep wall) would have areas hundreds of times below their neighbours', and a
+  // transfer is limited by the smaller area, so the wall would settle only after thousands
+  // of passes (a tool deeper than the bed: 7900 settling passes, 200 with the floor).
+  const double shortest = std::max(8.0 * snap + 16.0 * tiny, w.gap);
   auto refine = [&](auto&& self, const Vec2& a, double za, const Vec2& b, double zb, int depth) -> void {
     const Vec2 m = 0.5 * (a + b);
-    if (depth >= 8 || (b - a).norm() < 8.0 * snap + 16.0 * tiny) return;
+    if (depth >= 8 || (b - a).norm() < shortest) return;
     const double zm = height(m);
     if (std::abs(zm - 0.5 * (za + zb)) <= tol) return;
     self(self, a, za, m, zm, depth + 1);
