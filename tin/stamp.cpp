@@ -38,7 +38,8 @@ constexpr std::size_t kMinSides = 8;
 
 }  // namespace
 
-double TinTerrain::drop_stale_constraints(std::uint32_t generation) {
+double TinTerrain::drop_stale_constraints(std::uint32_t generation, std::vector<VertexHandle>& region_vertices) {
+  region_vertices.clear();
   std::vector<std::pair<VertexHandle, VertexHandle>> stale;
   for (const auto& [key, g] : generations_) {
     if (g >= generation) continue;
@@ -61,7 +62,6 @@ double TinTerrain::drop_stale_constraints(std::uint32_t generation) {
   const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
   Capture capture = begin_capture(box.expanded(4.0 * spec_.snap_m + 1e-9 * extent));
   for (const auto& [a, b] : stale) unconstrain(a, b);
-  std::vector<VertexHandle> region_vertices;
   const CaptureResult measured = end_capture(capture, &region_vertices);
   for (VertexHandle v : region_vertices) {
     v->info().area = -1.0;
@@ -75,6 +75,19 @@ double TinTerrain::drop_stale_constraints(std::uint32_t generation) {
   // The flips that restore the Delaunay property change the surface a little: the caller
   // gives the volume back with the stamp's deposit.
   return measured.delta();
+}
+
+void TinTerrain::spread_volume(const std::vector<VertexHandle>& vertices, double volume) {
+  double total = 0.0;
+  for (VertexHandle v : vertices) total += vertex_area(v);
+  if (volume == 0.0 || !(total > 0.0)) return;
+  // Raising every vertex by the same dz changes the volume by dz times their areas' sum.
+  const double dz = volume / total;
+  for (VertexHandle v : vertices) {
+    set_z(v, v->point().z() + dz);
+    touch_with_neighbours(v);
+    add_to_simplify(v);
+  }
 }
 
 void TinTerrain::snap_border_crossings(std::vector<Vec2>& contour, double reach) {
@@ -101,13 +114,17 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   // The constraints of stamps that have passed only kept their walls from being flipped:
   // dropped, so the surface between old stamps is free to relax and coarsen (the Delaunay
   // triangulation minimises roughness, Rippa 1990).
-  const double unconstrained = drop_stale_constraints(s.generation);
+  std::vector<VertexHandle> stale_region;
+  const double unconstrained = drop_stale_constraints(s.generation, stale_region);
   stale_delta_ = spec_.conserve_volume ? unconstrained : 0.0;
   if (s.is_pour()) return pour(s);
   StampReport report;
   StampWork w;
-  if (!plan_stamp(s, w)) return report;  // off the domain
-  contour_points(w);                     // 1a
+  if (!plan_stamp(s, w)) {  // off the domain: no deposit to give the flips' change back with
+    spread_volume(stale_region, -stale_delta_);
+    return report;
+  }
+  contour_points(w);  // 1a
   find_constraints_near(w);
 
   // Everything the stamp changes lies in this box: O, the rim band, the dropped constraints.

@@ -219,6 +219,22 @@ TEST(TinStamp, NearTheBorderAndOffTheDomain) {
   }
 }
 
+TEST(TinStamp, AStampOffTheDomainGivesBackTheFlipsOfTheOnesBefore) {
+  // On dunes, dropping a passed stamp's constraints flips edges under a curved surface; the
+  // next stamp gives the change back with its deposit, and one off the domain (a stroke
+  // leaving it) must give it back too.
+  const Scene s = scene(kDunesScene);
+  auto t = make(s);
+  const double v0 = t->volume();
+  std::uint32_t generation = 0;
+  for (double x : {0.47, 0.48, 0.49})
+    t->stamp(stamp_at(s, {x, 0.25}, t->height({x, 0.25}) - 0.01, {1, 0}, generation++));
+  t->stamp(stamp_at(s, {0.6, 0.25}, 0.0, {1, 0}, generation++));
+  SB_EXPECT_TIN_OK(*t);
+  EXPECT_EQ(t->stats().constrained_edges, 0u);
+  EXPECT_NEAR(t->volume(), v0, 1e-13 * v0);
+}
+
 TEST(TinStamp, ToolAboveTheSurfaceRemovesNothing) {
   const Scene s = scene();
   auto t = make(s);

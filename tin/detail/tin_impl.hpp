@@ -196,8 +196,12 @@ class TinTerrain final : public Terrain {
   bool next_to_steep_face(VertexHandle v) const;
   StampReport pour(const ToolStamp& s);
   // Unconstrains every edge of a generation older than `generation` and returns the volume
-  // change of the flips (the stamp's deposit gives it back); O(constrained edges + region).
-  double drop_stale_constraints(std::uint32_t generation);
+  // change of the flips (the stamp's deposit gives it back), with the vertices of the faces
+  // they changed; O(constrained edges + region).
+  double drop_stale_constraints(std::uint32_t generation, std::vector<VertexHandle>& region_vertices);
+  // Raises the vertices by one dz that adds `volume` (a stamp off the domain gives the flips'
+  // change back so). O(vertices x degree).
+  void spread_volume(const std::vector<VertexHandle>& vertices, double volume);
   // Moves the points of a clipped contour that lie on the domain's border onto an existing
   // border vertex within `reach` on the same side, if there is one. O(points x vertices near).
   void snap_border_crossings(std::vector<Vec2>& contour, double reach);
