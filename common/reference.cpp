@@ -221,6 +221,20 @@ PlaneShape measure_plane(const Raster& h) {
     sq += r * r;
   }
   shape.rms_m = std::sqrt(sq / n);
+  // Local slopes over the same samples, where both neighbours along each axis exist.
+  double local_sum = 0.0;
+  std::size_t local_n = 0;
+  const double two_h = 2.0 * h.spacing_m;
+  for (std::size_t iy = std::max<std::size_t>(h.ny / 4, 1); iy + 1 < h.ny && iy < h.ny - h.ny / 4; ++iy)
+    for (std::size_t ix = std::max<std::size_t>(h.nx / 4, 1); ix + 1 < h.nx && ix < h.nx - h.nx / 4; ++ix) {
+      const double sx = (h.at(ix + 1, iy) - h.at(ix - 1, iy)) / two_h;
+      const double sy = (h.at(ix, iy + 1) - h.at(ix, iy - 1)) / two_h;
+      const double deg = rad_to_deg(std::atan(std::hypot(sx, sy)));
+      local_sum += deg;
+      shape.slope_max_deg = std::max(shape.slope_max_deg, deg);
+      ++local_n;
+    }
+  shape.slope_mean_deg = local_n ? local_sum / static_cast<double>(local_n) : 0.0;
   return shape;
 }
 
@@ -269,6 +283,8 @@ nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule&
     j["plane.slope_error_deg"] = p.slope_deg - crit;
     j["plane.azimuth_deg"] = p.azimuth_deg;
     j["plane.rms_m"] = p.rms_m;
+    j["plane.slope_mean_deg"] = p.slope_mean_deg;
+    j["plane.slope_max_deg"] = p.slope_max_deg;
   }
   return j;
 }

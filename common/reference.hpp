@@ -61,6 +61,10 @@ struct PlaneShape {
   double slope_deg = 0.0;    // of the least-squares plane over the middle half of the domain
   double azimuth_deg = 0.0;  // its downhill direction, counter-clockwise from +x, in (-180, 180]
   double rms_m = 0.0;        // residual of the fit
+  // Local slopes at the raster samples of the same region (central differences over two
+  // spacings), which the fit averages away: their mean and the steepest.
+  double slope_mean_deg = 0.0;
+  double slope_max_deg = 0.0;
 };
 PlaneShape measure_plane(const Raster& heights);
 

@@ -13,7 +13,7 @@ def run(ctx):
     alphas = ctx.profile["alpha"]
     if 0.0 not in alphas:
         alphas = [0.0] + list(alphas)
-    jobs = [(SCENE, "tin", f"alpha_flat/tin-a{a:g}", [f"tin.alpha_flat_deg={a}"]) for a in alphas]
+    jobs = [(SCENE, "tin", f"alpha_flat/tin-a{a:g}", [f"tin.alpha_flat_deg={a}", sbrun.PAPER_RULE]) for a in alphas]
     s = ctx.run_many("alpha_flat", jobs)
     rasters = []
     for j in jobs:

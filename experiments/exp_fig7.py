@@ -12,7 +12,7 @@ def run(ctx):
     import matplotlib.pyplot as plt
 
     ns = ctx.profile["fig7_n"]
-    common = [sbrun.diagonal_path(0.1), "erosion.relax_at_end=false"]
+    common = [sbrun.diagonal_path(0.1), "erosion.relax_at_end=false", sbrun.PAPER_RULE]
     jobs = []
     for n in ns:
         jobs.append((sbrun.DIAGONAL_SCENE, "tin", f"fig7/tin-N{n}", common + [f"tin.initial_points={n}"]))

@@ -13,7 +13,7 @@ def run(ctx):
     n = ctx.profile["fig8_n"]
     jobs = []
     for f in fractions:
-        common = [sbrun.diagonal_path(f), "erosion.relax_at_end=false"]
+        common = [sbrun.diagonal_path(f), "erosion.relax_at_end=false", sbrun.PAPER_RULE]
         jobs.append((sbrun.DIAGONAL_SCENE, "tin", f"fig8/tin-L{f:.2f}", common + [f"tin.initial_points={n}"]))
         jobs.append((sbrun.DIAGONAL_SCENE, "grid", f"fig8/grid-L{f:.2f}", common + [f"grid.cell_m={sbrun.grid_cell_for(n):.8f}"]))
         jobs.append((sbrun.DIAGONAL_SCENE, "sparse", f"fig8/sparse-L{f:.2f}",

@@ -26,6 +26,7 @@ import exp_fig7
 import exp_fig8_9
 import exp_haptics
 import exp_memory
+import exp_orientation
 import exp_sparse
 import exp_stability
 
@@ -38,6 +39,7 @@ EXPERIMENTS = {
     "drift": exp_drift,
     "alpha_flat": exp_alpha_flat,
     "accuracy": exp_accuracy,
+    "orientation": exp_orientation,
     "stability": exp_stability,
     "haptics": exp_haptics,
 }
