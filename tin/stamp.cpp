@@ -308,11 +308,7 @@ void TinTerrain::find_constraints_near(StampWork& w) {
       }
       const FaceHandle n = f->neighbor(i);
       if (cdt_.is_infinite(n) || n->info() == walked) continue;
-      const Point &p0 = n->vertex(0)->point(), &p1 = n->vertex(1)->point(), &p2 = n->vertex(2)->point();
-      const bool overlaps =
-          std::max({p0.x(), p1.x(), p2.x()}) >= reach.lo.x() && std::min({p0.x(), p1.x(), p2.x()}) <= reach.hi.x() &&
-          std::max({p0.y(), p1.y(), p2.y()}) >= reach.lo.y() && std::min({p0.y(), p1.y(), p2.y()}) <= reach.hi.y();
-      if (!overlaps) continue;
+      if (!face_overlaps(n, reach)) continue;
       n->info() = walked;
       faces.push_back(n);
     }

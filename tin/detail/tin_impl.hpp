@@ -8,6 +8,7 @@
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <unordered_map>
@@ -264,6 +265,12 @@ inline double face_area(FaceHandle f) {
 }
 inline double face_volume(FaceHandle f) {
   return face_area(f) * (f->vertex(0)->point().z() + f->vertex(1)->point().z() + f->vertex(2)->point().z()) / 3.0;
+}
+// Whether a finite face's bounding box meets the box (the test of the region walks).
+inline bool face_overlaps(FaceHandle f, const Aabb2& box) {
+  const Point &a = f->vertex(0)->point(), &b = f->vertex(1)->point(), &c = f->vertex(2)->point();
+  return std::max({a.x(), b.x(), c.x()}) >= box.lo.x() && std::min({a.x(), b.x(), c.x()}) <= box.hi.x() &&
+         std::max({a.y(), b.y(), c.y()}) >= box.lo.y() && std::min({a.y(), b.y(), c.y()}) <= box.hi.y();
 }
 inline Vec2 xy(const Point& p) { return {p.x(), p.y()}; }
 inline Vec2 xy(VertexHandle v) { return xy(v->point()); }
