@@ -26,9 +26,10 @@
 //   erode             O(|L_e| * degree) per pass (vertex areas are cached), about 0.25 us
 //                     per vertex visit; an edge split is O(1)
 //   simplify          detect O(|L_r| * degree); removal O(degree) per vertex
-//   one step          stamp + 4 erosion passes + simplify: 1.7 to 2.1 ms at every n from 10^3
-//                     to 10^6, log-log slope -0.01 (tests/bench/tin_step_bench.cpp), where
-//                     the paper measured O(n^1.5)
+//   one step          stamp + 4 erosion passes + simplify: 0.6 to 0.7 ms CPU at every n from
+//                     10^3 to 10^6, on tin.initial_points TINs with their border points too,
+//                     log-log slope -0.006 (tests/bench/tin_step_bench.cpp; 0.73 ms on the
+//                     heightmap scene's TIN), where the paper measured O(n^1.5)
 //   volume, mesh, check, max_slope_deg: O(n); sample: O(raster points), walking row by row
 // Volume: stamps, erosion and simplification conserve volume except where the Delaunay
 // triangulation changes under a non-planar surface (flips after insertions and edge splits,
