@@ -47,10 +47,9 @@ struct ErosionSpec {
   double settle_tolerance_deg = 0.1;  // slopes up to critical + this count as stable
   bool relax_at_end = true;           // after the stroke, erode until settled
   int relax_max_passes = 20000;
-  // "edge" (the paper's rule: neighbour directions only; the default until the TIN passes
-  // its tests with the other) or "gradient" (at rest at the critical angle in every
-  // azimuth); see common/erosion.hpp.
-  ErosionRuleKind rule = ErosionRuleKind::Edge;
+  // "gradient" (at rest at the critical angle in every azimuth) or "edge" (the paper's
+  // rule: neighbour directions only); see common/erosion.hpp.
+  ErosionRuleKind rule = ErosionRuleKind::Gradient;
 };
 
 struct TinSpec {

@@ -30,8 +30,8 @@ std::string scene_key_meaning(const std::string& key) {
       {"erosion.relax_at_end", "settle after the stroke (recorded as steps with stamp -1)"},
       {"erosion.relax_max_passes", "at most this many settling passes"},
       {"erosion.rule",
-       "\"edge\": slopes along neighbour directions only (the paper's); \"gradient\": also along the downhill "
-       "gradient, so a surface rests at the critical angle in every azimuth"},
+       "\"gradient\" (default): also along the downhill gradient, so a surface rests at the critical angle in "
+       "every azimuth; \"edge\": slopes along neighbour directions only (the paper's)"},
       {"tool.shape", "footprint"},
       {"tool.radius_m", "disk radius; pour radius"},
       {"tool.size_m", "box: full sizes; ellipse: axes (along and across the motion)"},

@@ -76,7 +76,10 @@ std::size_t TinTerrain::refine_around(VertexHandle v) {
   return splits;
 }
 
-ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& budget) {
+ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& budget) {
+  // The fan gradient is too coarse an estimate to cap drops by (common/erosion.hpp).
+  ErosionRule rule = given;
+  rule.cap_drop = false;
   if (!std::isfinite(rule.tan_critical) || !std::isfinite(rule.tan_settle) || !std::isfinite(rule.fraction) ||
       rule.tan_critical < 0.0 || rule.fraction < 0.0)
     throw InputError("erosion: the rule's slopes and fraction must be finite and non-negative");
@@ -125,7 +128,11 @@ ErosionReport TinTerrain::erode(const ErosionRule& rule, const ErosionBudget& bu
           if (transfer_scratch_[k] <= 0.0 || nbr_scratch_[k].area <= 0.0) continue;
           const VertexHandle w = vertex_scratch_[k];
           set_z(w, w->point().z() + transfer_scratch_[k] / nbr_scratch_[k].area);
-          touch(w);
+          // The gradient rule reads w's height in its neighbours' fan gradients too.
+          if (rule.needs_gradient())
+            touch_with_neighbours(w);
+          else
+            touch(w);
           add_to_simplify(w);
           ++report.transfers;
         }

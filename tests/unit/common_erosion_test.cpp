@@ -117,14 +117,17 @@ TEST(ErosionRule, FanGradientIsExactOnPlanesAndIgnoresTheBorderGap) {
 // The gradient rule's promise: a plane at the critical angle rests in every azimuth, a
 // steeper one does not; the edge rule lets planes between neighbour directions stand steeper.
 TEST(ErosionRule, GradientRuleRestsPlanesAtTheCriticalAngleInEveryAzimuth) {
-  const ErosionRule gradient = rule30(0.5, ErosionRuleKind::Gradient, 0.1);
+  ErosionRule gradient = rule30(0.5, ErosionRuleKind::Gradient, 0.1);
   const ErosionRule edge = rule30(0.5, ErosionRuleKind::Edge, 0.1);
-  for (bool irregular : {false, true})
-    for (double az = 0.0; az < 360.0; az += 7.5) {
-      EXPECT_EQ(transfers_on_plane(30.0, az, irregular, gradient), 0.0) << az;
-      EXPECT_EQ(transfers_on_plane(29.0, az, irregular, gradient), 0.0) << az;
-      EXPECT_GT(transfers_on_plane(30.3, az, irregular, gradient), 0.0) << az;
-    }
+  for (bool cap : {true, false})  // on a plane the drop is what the gradient predicts
+    for (bool irregular : {false, true})
+      for (double az = 0.0; az < 360.0; az += 7.5) {
+        gradient.cap_drop = cap;
+        EXPECT_EQ(transfers_on_plane(30.0, az, irregular, gradient), 0.0) << az;
+        EXPECT_EQ(transfers_on_plane(29.0, az, irregular, gradient), 0.0) << az;
+        EXPECT_GT(transfers_on_plane(30.3, az, irregular, gradient), 0.0) << az;
+      }
+  gradient.cap_drop = true;
   // 22.5 degrees off the grid's directions: the edge rule holds 31.5 degrees, the gradient
   // rule does not.
   EXPECT_EQ(transfers_on_plane(31.5, 22.5, false, edge), 0.0);
@@ -149,6 +152,23 @@ TEST(ErosionRule, GradientRuleSendsOnlyDownhillAndConservesVolume) {
     }
     EXPECT_NEAR(sum, total, 1e-15 * total);
   }
+}
+
+// A neighbour 60 degrees off the downhill direction and lower than the plane predicts (a
+// convex surface): with the cap it counts only the gradient's drop, without it its own.
+TEST(ErosionRule, CapDropCountsAtMostTheGradientsDrop) {
+  ErosionRule rule = rule30(0.5, ErosionRuleKind::Gradient);
+  const double d = 0.01, s = std::tan(deg_to_rad(31.0));
+  const double dx = d * 0.5, dy = d * std::sqrt(3.0) / 2.0;          // run d / 2 along +x
+  std::array<ErosionNeighbour, 1> n{{{-0.4 * d, d, 1e-4, dx, dy}}};  // drop 0.4 d < d tan 30
+  std::array<double, 1> out{};
+  const SurfaceGradient g{-s, 0.0};  // downhill +x at 31 degrees
+  const double capped = erosion_transfers(0.0, 1e-4, g, n, rule, out);
+  rule.cap_drop = false;
+  const double full = erosion_transfers(0.0, 1e-4, g, n, rule, out);
+  const double a = 1e-4 * 1e-4 / 2e-4;  // A_i A_j / (A_i + A_j)
+  EXPECT_NEAR(capped, 0.5 * (s - std::tan(deg_to_rad(30.0))) * 0.5 * d * a, 1e-18);
+  EXPECT_NEAR(full, 0.5 * (0.4 * d - 0.5 * d * std::tan(deg_to_rad(30.0))) * a, 1e-18);
 }
 
 TEST(ErosionRule, EdgeRuleIgnoresTheGradient) {

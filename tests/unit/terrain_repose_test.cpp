@@ -117,7 +117,9 @@ using Backends = ::testing::Types<Tin, Grid, Sparse>;
 TYPED_TEST_SUITE(ReposeTyped, Backends, BackendName);
 
 TYPED_TEST(ReposeTyped, PlaneSteeperThanCriticalRelaxesToItInEveryAzimuth) {
-  for (double azimuth : {0.0, 22.5, 45.0, 120.0}) {
+  // Along a neighbour direction, between two (10, 22.5, 30, 67.5 on the 8-neighbour grid),
+  // and in another quadrant (120).
+  for (double azimuth : {0.0, 10.0, 22.5, 30.0, 45.0, 67.5, 120.0}) {
     const auto o = this->relax_plane(34.0, azimuth);
     EXPECT_TRUE(o.settled) << "azimuth " << azimuth;
     EXPECT_NEAR(o.before.slope_deg, 34.0, 0.01);
@@ -129,7 +131,7 @@ TYPED_TEST(ReposeTyped, PlaneSteeperThanCriticalRelaxesToItInEveryAzimuth) {
 }
 
 TYPED_TEST(ReposeTyped, PlaneBelowCriticalDoesNotMove) {
-  for (double azimuth : {0.0, 22.5, 45.0}) {
+  for (double azimuth : {0.0, 10.0, 22.5, 30.0, 45.0, 67.5}) {
     const auto o = this->relax_plane(28.0, azimuth);
     EXPECT_TRUE(o.settled);
     EXPECT_EQ(o.moved_far_m, 0.0) << "azimuth " << azimuth;
