@@ -14,15 +14,21 @@ namespace sb::tin::detail {
 double TinTerrain::gather_neighbours(VertexHandle v) {
   vertex_scratch_.clear();
   nbr_scratch_.clear();
-  const Vec2 p = xy(v);
-  auto c = cdt_.incident_vertices(v), done = c;
+  const Point& p = v->point();
+  // The vertex circulator's walk, unrolled (same start and counter-clockwise order): this is
+  // the hottest loop of a step.
+  const VertexHandle infinite = cdt_.infinite_vertex();
+  const FaceHandle start = v->face();
+  FaceHandle f = start;
   do {
-    if (cdt_.is_infinite(c)) continue;
-    const VertexHandle w = c;
+    const int i = Cdt::ccw(f->index(v));
+    const VertexHandle w = f->vertex(i);
+    f = f->neighbor(i);
+    if (w == infinite) continue;
     vertex_scratch_.push_back(w);
-    const Vec2 e = xy(w) - p;
-    nbr_scratch_.push_back({w->point().z(), e.norm(), cached_area(w), e.x(), e.y()});
-  } while (++c != done);
+    const double ex = w->point().x() - p.x(), ey = w->point().y() - p.y();
+    nbr_scratch_.push_back({w->point().z(), std::sqrt(ex * ex + ey * ey), cached_area(w), ex, ey});
+  } while (f != start);
   return cached_area(v);
 }
 
@@ -114,7 +120,9 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
         set_z(v, v->point().z() - total / area);
         // One ring: v fell, so its neighbours' drops towards v grew; a receiver rose, which
         // only its own drops grow (its neighbours' drops towards it shrank).
-        touch_with_neighbours(v);
+        // (vertex_scratch_ holds v's neighbours: no second circulation.)
+        touch(v);
+        for (VertexHandle w : vertex_scratch_) touch(w);
         add_to_simplify(v);
         for (std::size_t k = 0; k < nbr_scratch_.size(); ++k) {
           if (transfer_scratch_[k] <= 0.0 || nbr_scratch_[k].area <= 0.0) continue;

@@ -440,11 +440,7 @@ void TinTerrain::collect_vertices(const Aabb2& box, std::vector<VertexHandle>& o
       }
       const FaceHandle n = f->neighbor(i);
       if (cdt_.is_infinite(n) || n->info() == visited) continue;
-      const Point &a = n->vertex(0)->point(), &b = n->vertex(1)->point(), &c = n->vertex(2)->point();
-      const bool overlaps =
-          std::max({a.x(), b.x(), c.x()}) >= box.lo.x() && std::min({a.x(), b.x(), c.x()}) <= box.hi.x() &&
-          std::max({a.y(), b.y(), c.y()}) >= box.lo.y() && std::min({a.y(), b.y(), c.y()}) <= box.hi.y();
-      if (!overlaps) continue;
+      if (!face_overlaps(n, box)) continue;
       n->info() = visited;
       queue.push_back(n);
     }

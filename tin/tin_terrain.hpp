@@ -20,13 +20,16 @@
 //                     sorted insertion (about 2 s for 10^6 points)
 //   height(p)         one walk from the last located face: O(1) for nearby queries
 //   stamp             O(k): contours inserted, old constraints dropped, constraints enforced,
-//                     vertices removed, the rim refined (about 0.6 ms for a 1.5 cm disk)
+//                     vertices removed, the rim refined (about 0.4 ms for a 1.5 cm disk); a
+//                     convex footprint keeps one corner per refine_m_ of perimeter (8 to 64,
+//                     evenly spaced, same area), so tool.sides = 4096 costs what 16 sides do
 //   erode             O(|L_e| * degree) per pass (vertex areas are cached), about 0.25 us
 //                     per vertex visit; an edge split is O(1)
 //   simplify          detect O(|L_r| * degree); removal O(degree) per vertex
-//   one step          stamp + 4 erosion passes + simplify: 1.7 to 2.1 ms at every n from 10^3
-//                     to 10^6, log-log slope -0.01 (tests/bench/tin_step_bench.cpp), where
-//                     the paper measured O(n^1.5)
+//   one step          stamp + 4 erosion passes + simplify: 0.6 to 0.7 ms CPU at every n from
+//                     10^3 to 10^6, on tin.initial_points TINs with their border points too,
+//                     log-log slope -0.006 (tests/bench/tin_step_bench.cpp; 0.73 ms on the
+//                     heightmap scene's TIN), where the paper measured O(n^1.5)
 //   volume, mesh, check, max_slope_deg: O(n); sample: O(raster points), walking row by row
 // Volume: stamps, erosion and simplification conserve volume except where the Delaunay
 // triangulation changes under a non-planar surface (flips after insertions and edge splits,
@@ -38,7 +41,9 @@
 // face count (CGAL's number_of_faces() circulates the hull: O(sqrt(n)) with border points).
 // Stale constraints (of stamps before the current one) are dropped at each stamp. A tool
 // deeper than the bed stops at z = 0. Erosion re-activates one ring (the giver's
-// neighbours, the receivers themselves); tan_settle is its settling criterion.
+// neighbours, the receivers themselves); tan_settle is its settling criterion. A stamp
+// re-activates the vertices whose heights it changed with their neighbours, and of the rest
+// of the retriangulated region only vertices next to a face steeper than critical.
 // Not thread-safe: height() and sample() move the walk hint.
 #include <memory>
 #include <vector>

@@ -16,6 +16,13 @@
 //
 //   build/<dir>/tests/tin_step_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 //
+// Two more series build their TIN the way a scene does (tin::make_tin_terrain):
+//  - BM_TinStepInitialPoints: `tin.initial_points` = N on a plane tilted by 3.4 degrees
+//    (terrain.kind = "plane"), the domain growing with N at the same 6 mm spacing, so the
+//    stamps meet the same lattice at every N, border points and all;
+//  - BM_TinStepHeightmap: the 16-bit heightmap of experiments/scenes/heightmap.toml (greedy
+//    insertion to tin.tolerance_m), stamped on a circle around the domain's centre.
+//
 // The cost per step should not grow with N: the printed slopes should be below 0.1.
 #include <benchmark/benchmark.h>
 
@@ -30,6 +37,7 @@
 #include <vector>
 
 #include "common/erosion.hpp"
+#include "common/height_field.hpp"
 #include "common/metrics.hpp"
 #include "common/scene.hpp"
 #include "tin/tin_terrain.hpp"
@@ -64,6 +72,7 @@ struct Setup {
   std::unique_ptr<sb::Terrain> terrain;
   sb::Vec2 centre;
   sb::ErosionRule rule;
+  bool from_scene = false;  // built by make_tin_terrain: stamp depths from the TIN itself
 };
 
 std::unique_ptr<Setup> build(std::int64_t n, bool conserve, bool border) {
@@ -101,7 +110,7 @@ sb::ToolStamp pose(const Setup& s, int k) {
   const sb::Vec2 motion(-std::sin(a), std::cos(a));
   sb::ToolPose p;
   p.xy = s.centre + offset;
-  p.bottom_z = surface(offset) - kDepth;
+  p.bottom_z = (s.from_scene ? s.terrain->height(p.xy) : surface(offset)) - kDepth;
   p.heading_rad = std::atan2(motion.y(), motion.x());
   return sb::make_stamp(s.scene.tool, p, motion, static_cast<std::uint32_t>(k));
 }
@@ -126,6 +135,27 @@ void step(Setup& s, int k, PhaseTimes* times = nullptr) {
   }
 }
 
+// A TIN built as a scene builds it: tin.initial_points = N on a tilted plane (6 mm spacing),
+// or the heightmap scene (n = 0).
+std::unique_ptr<Setup> build_from_scene(std::int64_t n) {
+  auto s = std::make_unique<Setup>();
+  if (n > 0) {
+    const double size = kSpacing * std::sqrt(static_cast<double>(n));
+    const std::string text = "[domain]\nsize_m = [" + std::to_string(size) + ", " + std::to_string(size) +
+                             "]\n[terrain]\nkind = \"plane\"\nheight_m = 1.0\nslope_deg = 3.4\nazimuth_deg = 30.0\n" +
+                             "[tool]\nshape = \"disk\"\nradius_m = " + std::to_string(kToolRadius) +
+                             "\ndepth_m = " + std::to_string(kDepth) + "\n[stroke]\npath_m = [[0.0, 0.0]]\n";
+    s->scene = sb::parse_scene(text, "tin_step_bench", {"tin.initial_points=" + std::to_string(n)});
+  } else {
+    s->scene = sb::load_scene(std::string(SB_SOURCE_DIR) + "/experiments/scenes/heightmap.toml");
+  }
+  s->centre = s->scene.domain.origin_m + 0.5 * s->scene.domain.size_m;
+  s->rule = sb::ErosionRule::from(s->scene.material, s->scene.erosion.settle_tolerance_deg, s->scene.erosion.rule);
+  s->terrain = sb::tin::make_tin_terrain(s->scene, sb::HeightField::from_scene(s->scene));
+  s->from_scene = true;
+  return s;
+}
+
 // Built once per (N, conserve) and kept: construction is not what is measured.
 Setup& setup(std::int64_t n, bool conserve, bool border) {
   static std::map<std::tuple<std::int64_t, bool, bool>, std::unique_ptr<Setup>> cache;
@@ -137,8 +167,7 @@ Setup& setup(std::int64_t n, bool conserve, bool border) {
   return *slot;
 }
 
-void BM_TinStep(benchmark::State& state) {
-  Setup& s = setup(state.range(0), state.range(1) != 0, state.range(2) != 0);
+void run_steps(benchmark::State& state, Setup& s) {
   const sb::ModelStats before = s.terrain->stats();
   int k = 0;
   PhaseTimes times;
@@ -155,6 +184,24 @@ void BM_TinStep(benchmark::State& state) {
   state.counters["MB"] = static_cast<double>(after.bytes) / 1e6;
 }
 
+void BM_TinStep(benchmark::State& state) {
+  run_steps(state, setup(state.range(0), state.range(1) != 0, state.range(2) != 0));
+}
+
+// Per N (0: the heightmap), built once and warmed up like setup().
+Setup& scene_setup(std::int64_t n) {
+  static std::map<std::int64_t, std::unique_ptr<Setup>> cache;
+  auto& slot = cache[n];
+  if (!slot) {
+    slot = build_from_scene(n);
+    for (int k = 0; k < 2 * kPoses; ++k) step(*slot, k);
+  }
+  return *slot;
+}
+
+void BM_TinStepInitialPoints(benchmark::State& state) { run_steps(state, scene_setup(state.range(0))); }
+void BM_TinStepHeightmap(benchmark::State& state) { run_steps(state, scene_setup(0)); }
+
 BENCHMARK(BM_TinStep)
     ->ArgNames({"N", "conserve", "border"})
     ->Args({1000, 0, 0})
@@ -169,6 +216,15 @@ BENCHMARK(BM_TinStep)
     ->Args({1000000, 1, 1})
     ->Iterations(240)
     ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TinStepInitialPoints)
+    ->ArgName("N")
+    ->Arg(1000)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->Iterations(240)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TinStepHeightmap)->Iterations(240)->Unit(benchmark::kMicrosecond);
 
 // Collects the median (or the only) CPU time (the machine may be shared) per (conserve, border) series and N, and
 // prints the least-squares slope of log(time) against log(N).
@@ -180,11 +236,12 @@ class SlopeReporter : public benchmark::ConsoleReporter {
       if (r.error_occurred || (r.run_type == Run::RT_Aggregate && r.aggregate_name != "median")) continue;
       if (r.run_type == Run::RT_Iteration && r.repetitions > 1) continue;
       const std::string name = r.run_name.str();  // BM_TinStep/N:1000/conserve:0/border:1
-      const auto field = [&name](const std::string& key) {
-        const auto at = name.find(key + ":");
-        return at == std::string::npos ? -1.0 : std::stod(name.substr(at + key.size() + 1));
-      };
-      series_[name.substr(name.find("/conserve"))].emplace_back(field("N"), r.GetAdjustedCPUTime());
+      const auto at = name.find("/N:");
+      if (at == std::string::npos) continue;
+      const auto end = name.find('/', at + 1);
+      // The series: the name without its N (BM_TinStep/conserve:0/border:1).
+      const std::string series = name.substr(0, at) + (end == std::string::npos ? "" : name.substr(end));
+      series_[series].emplace_back(std::stod(name.substr(at + 3)), r.GetAdjustedCPUTime());
     }
   }
   void Finalize() override {
@@ -200,7 +257,8 @@ class SlopeReporter : public benchmark::ConsoleReporter {
         sxy += (std::log(n) - mx) * (std::log(t) - my);
         sxx += (std::log(n) - mx) * (std::log(n) - mx);
       }
-      std::printf("log-log slope of the step time against N%s: %.3f (%zu sizes)\n", key.c_str(), sxy / sxx, pts.size());
+      std::printf("log-log slope of the step time against N, %s: %.3f (%zu sizes)\n", key.c_str(), sxy / sxx,
+                  pts.size());
     }
   }
 

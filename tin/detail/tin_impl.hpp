@@ -8,6 +8,7 @@
 #include <CGAL/Triangulation_face_base_with_info_2.h>
 #include <CGAL/Triangulation_vertex_base_with_info_2.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <unordered_map>
@@ -113,6 +114,8 @@ struct CaptureResult {
   double delta() const { return volume_after - volume_before; }
 };
 
+struct StampWork;  // stamp_work.hpp
+
 // The edge length erosion refines to when tin.refine_m is 0: 4 tin.tolerance_m / tan(critical
 // angle), at most 5 % of the domain (build.cpp).
 double default_refine_m(const Scene& scene);
@@ -173,11 +176,33 @@ class TinTerrain final : public Terrain {
   std::uint32_t next_face_epoch();
   std::uint32_t next_vertex_epoch();
 
-  // stamp.cpp
+  // stamp.cpp: the paper's steps 1a-1f, in the order stamp() takes them.
+  // The footprint made ready (checked, cut to what the mesh resolves), the contours O and I
+  // clipped to the domain; false when O misses the domain.
+  bool plan_stamp(const ToolStamp& s, StampWork& w);
+  void contour_points(StampWork& w) const;   // 1a: O's heights, I, interior and rim points
+  void find_constraints_near(StampWork& w);  // old constraints within reach of O (w.dropped)
+  // The stamp's vertices inserted; old ones between I and O (and just outside O) removed.
+  void insert_stamp_vertices(StampWork& w, StampReport& report);
+  void constrain_contours(const StampWork& w);               // 1b, 1c
+  void lower_to_tool(StampWork& w);                          // 1d
+  void remove_redundant(StampWork& w, StampReport& report);  // 1e
+  // 1d (cont.): `deposit` spread over the rim band; returns what was deposited.
+  double deposit_on_rim(StampWork& w, double deposit, StampReport& report);
+  // 1f: the vertices whose heights changed join L_e with their neighbours, and L_r; of the
+  // retriangulated region's other vertices only those next to a face steeper than critical.
+  void activate(const StampWork& w, const std::vector<VertexHandle>& region_vertices);
+  // Whether a finite face incident to v is steeper than the critical slope: if none is, no
+  // edge of v's star is, nor the star's mean gradient, so erosion has nothing to move at v.
+  bool next_to_steep_face(VertexHandle v) const;
   StampReport pour(const ToolStamp& s);
   // Unconstrains every edge of a generation older than `generation` and returns the volume
-  // change of the flips (the stamp's deposit gives it back); O(constrained edges + region).
-  double drop_stale_constraints(std::uint32_t generation);
+  // change of the flips (the stamp's deposit gives it back), with the vertices of the faces
+  // they changed; O(constrained edges + region).
+  double drop_stale_constraints(std::uint32_t generation, std::vector<VertexHandle>& region_vertices);
+  // Raises the vertices by one dz that adds `volume` (a stamp off the domain gives the flips'
+  // change back so). O(vertices x degree).
+  void spread_volume(const std::vector<VertexHandle>& vertices, double volume);
   // Moves the points of a clipped contour that lie on the domain's border onto an existing
   // border vertex within `reach` on the same side, if there is one. O(points x vertices near).
   void snap_border_crossings(std::vector<Vec2>& contour, double reach);
@@ -240,6 +265,12 @@ inline double face_area(FaceHandle f) {
 }
 inline double face_volume(FaceHandle f) {
   return face_area(f) * (f->vertex(0)->point().z() + f->vertex(1)->point().z() + f->vertex(2)->point().z()) / 3.0;
+}
+// Whether a finite face's bounding box meets the box (the test of the region walks).
+inline bool face_overlaps(FaceHandle f, const Aabb2& box) {
+  const Point &a = f->vertex(0)->point(), &b = f->vertex(1)->point(), &c = f->vertex(2)->point();
+  return std::max({a.x(), b.x(), c.x()}) >= box.lo.x() && std::min({a.x(), b.x(), c.x()}) <= box.hi.x() &&
+         std::max({a.y(), b.y(), c.y()}) >= box.lo.y() && std::min({a.y(), b.y(), c.y()}) <= box.hi.y();
 }
 inline Vec2 xy(const Point& p) { return {p.x(), p.y()}; }
 inline Vec2 xy(VertexHandle v) { return xy(v->point()); }
