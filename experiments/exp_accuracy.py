@@ -4,6 +4,8 @@
 erosion refinement), each with both erosion rules (`edge`, the paper's; `gradient`), time per
 step against error on one set of axes, Pareto fronts marked. The trench is dug at several
 azimuths and scored by its worst one, so no stencil is judged on its best direction only."""
+import math
+
 import sbrun
 from exp_orientation import turned
 
@@ -14,6 +16,8 @@ CASES = {
     "trench": ("trench_azimuth.toml", "trench.wall_worst_error_deg",
                "worst |wall section - critical| over azimuths [deg]"),
 }
+# The tool radius of crater.toml (its TIN sweep is over polygon sides).
+TOOL_RADIUS_M = {"crater": 0.02}
 # The crater has no erosion (one bare stamp): it runs once, with the edge rule named explicitly.
 RULES = {"pile": ["edge", "gradient"], "crater": ["edge"], "trench": ["edge", "gradient"]}
 # Trench azimuths per profile: along x, between the 8-neighbour stencil's directions, diagonal
@@ -34,13 +38,18 @@ def sweeps(profile_name, case):
     # The sparse grid has the dense grid's heights; its points show the price of its storage.
     grid += [(f"sparse {c * 1000:g} mm 8-nb", "sparse", [f"grid.cell_m={c}", "grid.neighbours=8"]) for c in cells]
     sides = {"tiny": [16, 32], "paper": [16, 32, 64], "full": [16, 32, 64, 128]}[profile_name]
-    # A 1 mm refinement makes the TIN trench take minutes; it is in the full profile only. The
-    # tiny profile (tests) has none: the TIN pile alone would take most of its time.
-    refine = {"tiny": [], "paper": [0.0, 0.002], "full": [0.0, 0.002, 0.001]}[profile_name]
+    # A 1 mm refinement makes the TIN trench take minutes; it is in the full profile only.
+    refine = {"tiny": [0.0], "paper": [0.0, 0.002], "full": [0.0, 0.002, 0.001]}[profile_name]
     tin = []
-    if case != "pile":
-        tin += [(f"tin {s}-gon", "tin", [f"tool.sides={s}"]) for s in sides]
-        tin += [(f"tin {sides[-1]}-gon subdiv 2 mm", "tin", [f"tool.sides={sides[-1]}", "tin.contour_subdivision_m=0.002"])]
+    if case == "crater":
+        # The TIN stamps a convex tool with as many corners as its mesh resolves (about one per
+        # tin.refine_m of perimeter, README `tool.sides`): each polygon comes with the refinement
+        # that resolves it, so the sweep is over resolution, not over corners the TIN would drop.
+        # (The trench's TIN sweep is over refinement alone, which sets its corners the same way.)
+        perimeter = 2 * math.pi * TOOL_RADIUS_M[case]
+        tin += [(f"tin {s}-gon", "tin", [f"tool.sides={s}", f"tin.refine_m={0.99 * perimeter / s:.6f}"]) for s in sides]
+        tin += [(f"tin {sides[-1]}-gon subdiv 2 mm", "tin", [f"tool.sides={sides[-1]}",
+                 f"tin.refine_m={0.99 * perimeter / sides[-1]:.6f}", "tin.contour_subdivision_m=0.002"])]
     if case != "crater":
         tin += [(f"tin refine {r * 1000:g} mm" if r > 0 else "tin refine default", "tin", [f"tin.refine_m={r}"])
                 for r in refine]
