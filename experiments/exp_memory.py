@@ -26,7 +26,9 @@ def run(ctx):
              stroke + [f"grid.cell_m={ctx.profile['reference_cell']}"])]
     jobs += [(sbrun.DIAGONAL_SCENE, "grid", f"memory/grid-{c}", stroke + [f"grid.cell_m={c}"]) for c in cells]
     tin_variants = [("TIN (4 corners + tool)", []), ("TIN, contour subdivided 2.5 mm", ["tin.contour_subdivision_m=0.0025"]),
-                    ("TIN, 64-gon tool", ["tool.sides=64"])]
+                    # The TIN stamps the corners its mesh resolves (one per tin.refine_m of perimeter):
+                    # a 64-gon needs a refinement of 2 pi r / 64.
+                    ("TIN, 64-gon tool, refined to resolve it", ["tool.sides=64", "tin.refine_m=0.001944"])]
     jobs += [(sbrun.DIAGONAL_SCENE, "tin", f"memory/tin-{i}", stroke + o) for i, (_, o) in enumerate(tin_variants)]
     jobs += [(sbrun.DIAGONAL_SCENE, "sparse", f"memory/sparse-{c}", stroke + [f"grid.cell_m={c}"]) for c in cells]
     s = ctx.run_many("memory", jobs)
