@@ -11,6 +11,7 @@
 #include <memory>
 #include <random>
 
+#include "bench_scenes.hpp"
 #include "common/haptics/force_model.hpp"
 #include "common/haptics/servo_core.hpp"
 #include "common/haptics/shared_pose_device.hpp"
@@ -26,23 +27,7 @@ using namespace sb::haptics;
 
 // Dunes over the paper's domain (diagonal 1 m); grid cell for 317 x 317 = 100489 nodes.
 const Scene& scene() {
-  static const Scene s = parse_scene(R"(
-[domain]
-size_m = [0.70710678, 0.70710678]
-[terrain]
-kind = "dunes"
-height_m = 0.1
-amplitude_m = 0.02
-wavelength_m = 0.2
-[tool]
-shape = "disk"
-radius_m = 0.02
-[stroke]
-path_m = [[0.35, 0.35]]
-[grid]
-cell_m = 0.0022360679
-)",
-                                     "haptics_bench.toml");
+  static const Scene s = parse_scene(bench::kPaperDunesScene, "haptics_bench.toml", {"grid.cell_m=0.0022360679"});
   return s;
 }
 

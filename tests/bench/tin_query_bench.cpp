@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_scenes.hpp"
 #include "common/haptics/force_model.hpp"
 #include "common/haptics/height_patch.hpp"
 #include "common/height_field.hpp"
@@ -35,21 +36,7 @@ using namespace sb;
 
 // Dunes over the paper's domain (diagonal 1 m), N initial points.
 Scene scene_with(std::int64_t n) {
-  return parse_scene(R"(
-[domain]
-size_m = [0.70710678, 0.70710678]
-[terrain]
-kind = "dunes"
-height_m = 0.1
-amplitude_m = 0.02
-wavelength_m = 0.2
-[tool]
-shape = "disk"
-radius_m = 0.02
-[stroke]
-path_m = [[0.35, 0.35]]
-)",
-                     "tin_query_bench.toml", {"tin.initial_points=" + std::to_string(n)});
+  return parse_scene(bench::kPaperDunesScene, "tin_query_bench.toml", {"tin.initial_points=" + std::to_string(n)});
 }
 
 // Built once per size (a 10^6-vertex TIN takes seconds), outside the timed loops.

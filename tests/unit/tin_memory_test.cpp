@@ -1,55 +1,7 @@
-// stats().bytes against allocator accounting, and check() after every operation.
-//
-// This file replaces the global operator new/delete for the whole sb_tin_tests executable:
-// every allocation carries a 16-byte header with its size and whether it was made while
-// counting, so that the live bytes of the allocations made since counting began are known.
-#include <atomic>
-#include <cstdlib>
-#include <new>
-
-#include "tests/unit/tin_test_support.hpp"
-
-namespace {
-
-std::atomic<bool> g_counting{false};
-std::atomic<long long> g_live_bytes{0};
-constexpr std::size_t kHeader = 16;
-
-void* counted_alloc(std::size_t n) {
-  void* raw = std::malloc(n + kHeader);
-  if (!raw) throw std::bad_alloc();
-  auto* header = static_cast<std::size_t*>(raw);
-  header[0] = n;
-  header[1] = g_counting.load(std::memory_order_relaxed) ? 1 : 0;
-  if (header[1]) g_live_bytes.fetch_add(static_cast<long long>(n), std::memory_order_relaxed);
-  return static_cast<char*>(raw) + kHeader;
-}
-
-void counted_free(void* p) noexcept {
-  if (!p) return;
-  auto* header = reinterpret_cast<std::size_t*>(static_cast<char*>(p) - kHeader);
-  if (header[1]) g_live_bytes.fetch_sub(static_cast<long long>(header[0]), std::memory_order_relaxed);
-  std::free(header);
-}
-
-}  // namespace
-
-void* operator new(std::size_t n) { return counted_alloc(n); }
-void* operator new[](std::size_t n) { return counted_alloc(n); }
-void* operator new(std::size_t n, const std::nothrow_t&) noexcept {
-  try {
-    return counted_alloc(n);
-  } catch (...) {
-    return nullptr;
-  }
-}
-void* operator new[](std::size_t n, const std::nothrow_t&) noexcept { return operator new(n, std::nothrow); }
-void operator delete(void* p) noexcept { counted_free(p); }
-void operator delete[](void* p) noexcept { counted_free(p); }
-void operator delete(void* p, std::size_t) noexcept { counted_free(p); }
-void operator delete[](void* p, std::size_t) noexcept { counted_free(p); }
-void operator delete(void* p, const std::nothrow_t&) noexcept { counted_free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { counted_free(p); }
+// stats().bytes against allocator accounting (the allocator counting_allocator.cpp installs
+// for sb_tin_tests), and check() after every operation.
+#include "counting_allocator.hpp"
+#include "tin_test_support.hpp"
 
 namespace sb::tin::test {
 namespace {
@@ -61,12 +13,10 @@ struct Counted {
 };
 template <class Make>
 Counted counted(Make&& make) {
-  const long long before = g_live_bytes.load();
-  g_counting = true;
+  const long long before = ::sb::test::live_heap_bytes();
   Counted c;
   c.terrain = make();
-  g_counting = false;
-  c.bytes = g_live_bytes.load() - before;
+  c.bytes = ::sb::test::live_heap_bytes() - before;
   return c;
 }
 
