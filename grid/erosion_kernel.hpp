@@ -78,8 +78,11 @@
 // (tests/bench/grid_bench.cpp, callgrind): ~180 instructions per visited node in a dense
 // pass where most visited nodes transfer, ~36 per node to class a row (8 neighbours,
 // double); active-set visits add ~100 for the set's bookkeeping.
+#include <immintrin.h>  // _mm256_movemask_pd, in the AVX2 classing only
+
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -163,15 +166,22 @@ inline VisitResult erosion_visit(Store& store, const ErosionTables& t, std::size
   // the excess along the neighbour's run on the downhill direction where it asks for more.
   double e[N];
   double largest = 0.0, sum = 0.0;
+  bool any = false;  // a pair beyond its margin (a stable node returns here, having written nothing)
   for (int s = 0; s < N; ++s) {
     const double excess = zi - zj[s] - c.crit[s];
-    e[s] = excess > c.margin[s] ? excess : 0.0;
+    const bool over = excess > c.margin[s];
+    any |= over;
+    e[s] = over ? excess : 0.0;
   }
-  if constexpr (Gradient) {
+  if constexpr (!Gradient) {
+    if (!any) return {};
+  } else {
     const double gx = (store.z(k + c.gx_hi) - store.z(k + c.gx_lo)) * c.inv_run_x;
     const double gy = (store.z(k + c.gy_hi) - store.z(k + c.gy_lo)) * c.inv_run_y;
     const double g2 = gx * gx + gy * gy;
-    if (g2 > t.tan_settle() * t.tan_settle()) {
+    const bool steep = g2 > t.tan_settle() * t.tan_settle();
+    if (!any && !steep) return {};
+    if (steep) {
       const double steepness = std::sqrt(g2);
       const double ux = -gx / steepness, uy = -gy / steepness;  // downhill unit vector
       for (int s = 0; s < N; ++s) {
@@ -210,8 +220,9 @@ inline VisitResult erosion_visit(Store& store, const ErosionTables& t, std::size
 }
 
 // Which sweep erode_ordered runs (tests force one; Auto is what the terrains use). Dense
-// sweeps the members' row spans.
-enum class SweepPath { Auto, ActiveSet, Dense };
+// sweeps the members' row spans; DenseBaseline is Dense with its rows classed in SSE2
+// registers even where the CPU has AVX2 (tests: both give the same heights, bit for bit).
+enum class SweepPath { Auto, ActiveSet, Dense, DenseBaseline };
 
 // Whether a pass sweeps the members' row spans (dense_pass) rather than the members: a dense
 // pass costs about a sixth of an active-set visit per node it skips (instructions,
@@ -219,9 +230,9 @@ enum class SweepPath { Auto, ActiveSet, Dense };
 // the spans from the first to the last member of each row.
 inline bool dense_pass_pays(std::size_t active, std::size_t span_nodes) { return active * 8 >= span_nodes; }
 
-// Two heights at p[0..1], widened to double (GCC/Clang vector extensions: one SSE2 register
-// on baseline x86-64; no intrinsics, no FMA, so each lane computes what the scalar code
-// does, bit for bit).
+// Heights widened to double (GCC/Clang vector extensions, no FMA, so each lane computes what
+// the scalar code does, bit for bit): two at p[0..1] in one SSE2 register (baseline x86-64),
+// four at p[0..3] in one AVX2 register (only inside functions compiled for AVX2).
 using Double2 = double __attribute__((vector_size(16)));
 using Mask2 = std::int64_t __attribute__((vector_size(16)));
 template <class Real>
@@ -238,46 +249,139 @@ inline Double2 load2(const Real* p) {
   }
 }
 
-// Whether each interior node x in [max(1, x0), min(nx - 2, x1)] of a row of contiguous heights `z` (node
-// (0, iy); rows iy - 1 and iy + 1 at -nx and +nx) may transfer: the first half of
-// erosion_visit with the same floating-point expressions, so a node it calls stable is one
-// the visit would leave alone. Two nodes at a time. Interior rows only (every neighbour
-// present: the thresholds are the interior class's).
-template <int N, bool Gradient, class Real>
-void unstable_flags(const Real* z, std::size_t nx, std::size_t x0, std::size_t x1, const NodeClass& c,
-                    double tan_settle2, std::int64_t* out) {
-  const auto w = static_cast<std::ptrdiff_t>(nx);
-  // Local copies: `out` could alias the class's arrays as far as the compiler knows.
+// Bits of a row's flags, one per node (x at word x / 64, bit x % 64).
+inline bool bit_at(const std::uint64_t* bits, std::size_t x) { return (bits[x / 64] >> (x % 64)) & 1u; }
+// Ors the `count` low bits of `m` in at bit x (count <= 4; may straddle two words).
+inline void or_bits(std::uint64_t* bits, std::size_t x, std::uint64_t m) {
+  bits[x / 64] |= m << (x % 64);
+  if (x % 64 > 60) bits[x / 64 + 1] |= m >> (64 - x % 64);
+}
+// The first set bit in [from, to], or to + 1 if none. O(words).
+inline std::size_t first_bit(const std::uint64_t* bits, std::size_t from, std::size_t to) {
+  if (from > to) return to + 1;
+  std::size_t w = from / 64;
+  std::uint64_t word = bits[w] & (~std::uint64_t{0} << (from % 64));
+  while (word == 0) {
+    if (++w > to / 64) return to + 1;
+    word = bits[w];
+  }
+  const std::size_t x = w * 64 + static_cast<std::size_t>(std::countr_zero(word));
+  return x <= to ? x : to + 1;
+}
+// The last set bit in [from, to] into x (false if none). O(words).
+inline bool last_bit(const std::uint64_t* bits, std::size_t from, std::size_t to, std::size_t& x) {
+  if (from > to) return false;
+  std::size_t w = to / 64;
+  std::uint64_t word = bits[w] & (~std::uint64_t{0} >> (63 - to % 64));
+  while (word == 0) {
+    if (w-- == from / 64) return false;
+    word = bits[w];
+  }
+  x = w * 64 + 63 - static_cast<std::size_t>(std::countl_zero(word));
+  return x >= from;
+}
+
+// The thresholds of the interior class, copied (the flags could alias the class as far as
+// the compiler knows).
+template <int N>
+struct RowThresholds {
   std::ptrdiff_t off[N];
   double crit[N], margin[N];
-  for (int s = 0; s < N; ++s) off[s] = c.offset[s], crit[s] = c.crit[s], margin[s] = c.margin[s];
-  const double irx = c.inv_run_x, iry = c.inv_run_y;
-  const auto flag = [&](std::ptrdiff_t x) {  // one node, scalar
-    const double zi = static_cast<double>(z[x]);
-    bool u = false;
-    for (int s = 0; s < N; ++s) u |= zi - static_cast<double>(z[x + off[s]]) - crit[s] > margin[s];
-    if constexpr (Gradient) {
-      const double gx = (static_cast<double>(z[x + 1]) - static_cast<double>(z[x - 1])) * irx;
-      const double gy = (static_cast<double>(z[x + w]) - static_cast<double>(z[x - w])) * iry;
-      u |= gx * gx + gy * gy > tan_settle2;
-    }
-    return static_cast<std::int64_t>(u);
-  };
-  std::ptrdiff_t x = std::max<std::ptrdiff_t>(1, static_cast<std::ptrdiff_t>(x0));
-  const std::ptrdiff_t end = std::min<std::ptrdiff_t>(w - 1, static_cast<std::ptrdiff_t>(x1) + 1);  // exclusive
+  double inv_run_x, inv_run_y, tan_settle2;
+  RowThresholds(const NodeClass& c, double tan_settle2_) : inv_run_x(c.inv_run_x), inv_run_y(c.inv_run_y) {
+    for (int s = 0; s < N; ++s) off[s] = c.offset[s], crit[s] = c.crit[s], margin[s] = c.margin[s];
+    tan_settle2 = tan_settle2_;
+  }
+};
+
+// Whether node x of a row of contiguous heights `z` may transfer, scalar: the first half of
+// erosion_visit with the same floating-point expressions, so a node it calls stable is one
+// the visit would leave alone.
+template <int N, bool Gradient, class Real>
+inline bool unstable_at(const Real* z, std::ptrdiff_t w, std::ptrdiff_t x, const RowThresholds<N>& c) {
+  const double zi = static_cast<double>(z[x]);
+  bool u = false;
+  for (int s = 0; s < N; ++s) u |= zi - static_cast<double>(z[x + c.off[s]]) - c.crit[s] > c.margin[s];
+  if constexpr (Gradient) {
+    const double gx = (static_cast<double>(z[x + 1]) - static_cast<double>(z[x - 1])) * c.inv_run_x;
+    const double gy = (static_cast<double>(z[x + w]) - static_cast<double>(z[x - w])) * c.inv_run_y;
+    u |= gx * gx + gy * gy > c.tan_settle2;
+  }
+  return u;
+}
+
+// Sets the bit of each node x in [x0, x1] of a row of contiguous heights `z` (node (0, iy);
+// rows iy - 1 and iy + 1 at -nx and +nx) that may transfer (unstable_at), two nodes at a
+// time. Interior nodes of interior rows only (1 <= x0, x1 <= nx - 2: every neighbour present,
+// the thresholds are the interior class's). The bits of [x0, x1] must be clear.
+template <int N, bool Gradient, class Real>
+void unstable_bits(const Real* z, std::size_t nx, std::size_t x0, std::size_t x1, const RowThresholds<N>& c,
+                   std::uint64_t* out) {
+  const auto w = static_cast<std::ptrdiff_t>(nx);
+  auto x = static_cast<std::ptrdiff_t>(x0);
+  const auto end = static_cast<std::ptrdiff_t>(x1) + 1;
   for (; x + 2 <= end; x += 2) {
     const Double2 zi = load2(z + x);
     Mask2 u = {0, 0};
 #pragma GCC unroll 8
-    for (int s = 0; s < N; ++s) u |= zi - load2(z + x + off[s]) - crit[s] > margin[s];
+    for (int s = 0; s < N; ++s) u |= zi - load2(z + x + c.off[s]) - c.crit[s] > c.margin[s];
     if constexpr (Gradient) {
-      const Double2 gx = (load2(z + x + 1) - load2(z + x - 1)) * irx;
-      const Double2 gy = (load2(z + x + w) - load2(z + x - w)) * iry;
-      u |= gx * gx + gy * gy > tan_settle2;
+      const Double2 gx = (load2(z + x + 1) - load2(z + x - 1)) * c.inv_run_x;
+      const Double2 gy = (load2(z + x + w) - load2(z + x - w)) * c.inv_run_y;
+      u |= gx * gx + gy * gy > c.tan_settle2;
     }
-    std::memcpy(out + x, &u, sizeof u);  // lanes are 0 or -1
+    or_bits(out, static_cast<std::size_t>(x),
+            static_cast<std::uint64_t>(u[0] & 1) | static_cast<std::uint64_t>(u[1] & 2));
   }
-  for (; x < end; ++x) out[x] = flag(x);
+  for (; x < end; ++x)
+    if (unstable_at<N, Gradient>(z, w, x, c)) or_bits(out, static_cast<std::size_t>(x), 1);
+}
+
+// The same, four nodes at a time in AVX2 registers (the same expressions per lane: AVX2
+// brings no FMA, so no contraction; the results are those of unstable_bits bit for bit).
+// Only called where the CPU has AVX2 (has_avx2()).
+using Double4 = double __attribute__((vector_size(32)));
+using Mask4 = std::int64_t __attribute__((vector_size(32)));
+template <class Real>
+[[gnu::target("avx2"), gnu::always_inline]] inline Double4 load4(const Real* p) {
+  if constexpr (std::is_same_v<Real, double>) {
+    Double4 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  } else {
+    using Float4 = float __attribute__((vector_size(16)));
+    Float4 f;
+    std::memcpy(&f, p, sizeof f);
+    return __builtin_convertvector(f, Double4);
+  }
+}
+template <int N, bool Gradient, class Real>
+[[gnu::target("avx2")]] void unstable_bits_avx2(const Real* z, std::size_t nx, std::size_t x0, std::size_t x1,
+                                                const RowThresholds<N>& c, std::uint64_t* out) {
+  const auto w = static_cast<std::ptrdiff_t>(nx);
+  auto x = static_cast<std::ptrdiff_t>(x0);
+  const auto end = static_cast<std::ptrdiff_t>(x1) + 1;
+  for (; x + 4 <= end; x += 4) {
+    const Double4 zi = load4(z + x);
+    Mask4 u = {0, 0, 0, 0};
+#pragma GCC unroll 8
+    for (int s = 0; s < N; ++s) u |= zi - load4(z + x + c.off[s]) - c.crit[s] > c.margin[s];
+    if constexpr (Gradient) {
+      const Double4 gx = (load4(z + x + 1) - load4(z + x - 1)) * c.inv_run_x;
+      const Double4 gy = (load4(z + x + w) - load4(z + x - w)) * c.inv_run_y;
+      u |= gx * gx + gy * gy > c.tan_settle2;
+    }
+    or_bits(out, static_cast<std::size_t>(x),
+            static_cast<std::uint64_t>(_mm256_movemask_pd(reinterpret_cast<__m256d>(u))));
+  }
+  for (; x < end; ++x)
+    if (unstable_at<N, Gradient>(z, w, x, c)) or_bits(out, static_cast<std::size_t>(x), 1);
+}
+
+// Whether this CPU runs AVX2 (checked once).
+inline bool has_avx2() {
+  static const bool yes = __builtin_cpu_supports("avx2");
+  return yes;
 }
 
 // One dense pass, in place (Gauss-Seidel), in the direction the active set's next sweep
@@ -304,7 +408,7 @@ void unstable_flags(const Real* z, std::size_t nx, std::size_t x0, std::size_t x
 // unstable node -- plus O(words of the visited rows) to find the spans and update the set.
 template <int N, bool Gradient, class Store, class Active>
 void dense_pass(Store& store, Active& active, const typename Active::Spans& spans, const ErosionTables& t,
-                ErosionReport& report, double& moved) {
+                ErosionReport& report, double& moved, bool wide = true) {
   const std::size_t nx = t.layout().nx, ny = t.layout().ny;
   const unsigned pass = active.next_sweep();
   const bool y_up = pass % 2 == 0;
@@ -313,8 +417,9 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
   // The nodes that transferred, one row of words per visited row in visiting order.
   std::vector<std::uint64_t> moved_bits;
   constexpr bool kContiguous = requires { store.data(); };
-  std::vector<std::int64_t> flags(kContiguous ? nx : 0, 1);  // as wide as a double: one vector lane each
-  const double tan_settle2 = t.tan_settle() * t.tan_settle();
+  // The row's unstable nodes, one bit each (plus a word: or_bits may write one past the row).
+  std::vector<std::uint64_t> flags(kContiguous ? words + 1 : 0, 0);
+  const bool avx2 = wide && has_avx2();
   std::size_t prev_lo = 1, prev_hi = 0;  // span of the previous row's transfers (empty)
   std::size_t visited_rows = 0;
   const std::size_t first = y_up ? spans.y0 : spans.y1;
@@ -333,33 +438,57 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     ++visited_rows;
     prev_lo = 1, prev_hi = 0;
     if (!members && !live) continue;  // a row inside the members' rows with none
-    const bool interior_row = iy > 0 && iy + 1 < ny && nx >= 3;
     const NodeClass& middle = t.of(nx / 2, iy);
+    // Nodes in [skip_lo, skip_hi] without a flag may be skipped (empty: none may).
+    std::size_t skip_lo = 1, skip_hi = 0;
     if constexpr (kContiguous) {
-      if (interior_row)
-        unstable_flags<N, Gradient>(store.data() + iy * nx, nx, x0, x1, middle, tan_settle2, flags.data());
+      if (iy > 0 && iy + 1 < ny && nx >= 3) {
+        skip_lo = std::max<std::size_t>(1, x0);
+        skip_hi = std::min(nx - 2, x1);
+        if (skip_lo <= skip_hi) {
+          std::fill(flags.begin() + static_cast<std::ptrdiff_t>(skip_lo / 64),
+                    flags.begin() + static_cast<std::ptrdiff_t>(skip_hi / 64 + 2), std::uint64_t{0});
+          const RowThresholds<N> c(middle, t.tan_settle() * t.tan_settle());
+          const auto* row = store.data() + iy * nx;
+          if (avx2)
+            unstable_bits_avx2<N, Gradient>(row, nx, skip_lo, skip_hi, c, flags.data());
+          else
+            unstable_bits<N, Gradient>(row, nx, skip_lo, skip_hi, c, flags.data());
+        }
+      }
     }
-    const std::size_t flagged_lo = x0, flagged_hi = x1;
     std::size_t row_lo = nx, row_hi = 0;  // span of this row's transfers (empty)
     int since_transfer = 3;               // nodes visited since the last one that transferred, in this row
     std::size_t ix = x_up ? x0 : x1;
     while (true) {
-      const bool edge = ix < 2 || ix + 2 >= nx;
-      bool skip = false;
-      if constexpr (kContiguous)
-        skip = interior_row && since_transfer > 2 && ix > 0 && ix + 1 < nx && ix >= flagged_lo && ix <= flagged_hi &&
-               !flags[ix];
-      bool transferred = false;
-      if (!skip) {
-        const VisitResult v = erosion_visit<N, Gradient>(store, t, iy * nx + ix, edge ? t.of(ix, iy) : middle);
-        if (v.transfers > 0) {
-          transferred = true;
-          report.transfers += static_cast<std::size_t>(v.transfers);
-          moved += v.moved;
-          moved_row[ix / 64] |= std::uint64_t{1} << (ix % 64);
-          row_lo = std::min(row_lo, ix);
-          row_hi = std::max(row_hi, ix);
+      if (since_transfer > 2 && ix >= skip_lo && ix <= skip_hi && !bit_at(flags.data(), ix)) {
+        // Stable, and nothing it reads changed since it was classed: on to the next node that
+        // must be visited (flagged, or outside [skip_lo, skip_hi]), the span's end if none.
+        // (x0 and x1 are still the span's own ends here: they only grow past a transfer.)
+        std::size_t next;
+        bool found;
+        if (x_up) {
+          next = first_bit(flags.data(), ix + 1, skip_hi);
+          found = next <= skip_hi || skip_hi + 1 <= x1;
+        } else {
+          found = last_bit(flags.data(), skip_lo, ix - 1, next) || (skip_lo > x0 && (next = skip_lo - 1, true));
         }
+        if (!found) {
+          report.updates += x_up ? x1 - ix + 1 : ix - x0 + 1;
+          break;
+        }
+        report.updates += x_up ? next - ix : ix - next;
+        ix = next;
+      }
+      const VisitResult v =
+          erosion_visit<N, Gradient>(store, t, iy * nx + ix, ix < 2 || ix + 2 >= nx ? t.of(ix, iy) : middle);
+      const bool transferred = v.transfers > 0;
+      if (transferred) {
+        report.transfers += static_cast<std::size_t>(v.transfers);
+        moved += v.moved;
+        moved_row[ix / 64] |= std::uint64_t{1} << (ix % 64);
+        row_lo = std::min(row_lo, ix);
+        row_hi = std::max(row_hi, ix);
       }
       since_transfer = transferred ? 0 : since_transfer + 1;
       ++report.updates;
@@ -402,10 +531,11 @@ ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t
     ++report.passes;
     if (path != SweepPath::ActiveSet) {
       const typename Active::Spans spans = active.spans();
-      const bool dense = path == SweepPath::Dense || (dense_pass_pays(active.size(), spans.nodes) &&
-                                                      budget.max_updates - report.updates >= 2 * spans.nodes);
+      const bool forced = path == SweepPath::Dense || path == SweepPath::DenseBaseline;
+      const bool dense = forced || (dense_pass_pays(active.size(), spans.nodes) &&
+                                    budget.max_updates - report.updates >= 2 * spans.nodes);
       if (dense) {
-        dense_pass<N, Gradient>(store, active, spans, t, report, moved);
+        dense_pass<N, Gradient>(store, active, spans, t, report, moved, path != SweepPath::DenseBaseline);
         continue;
       }
     }
