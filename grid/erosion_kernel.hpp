@@ -149,6 +149,25 @@ class ErosionTables {
   std::vector<NodeClass> classes_;        // the classes that occur: at most 5 x 5
 };
 
+// Heights widened to double (GCC/Clang vector extensions, no FMA, so each lane computes what
+// the scalar code does, bit for bit): two at p[0..1] in one SSE2 register (baseline x86-64),
+// four at p[0..3] in one AVX2 register (only inside functions compiled for AVX2).
+using Double2 = double __attribute__((vector_size(16)));
+using Mask2 = std::int64_t __attribute__((vector_size(16)));
+template <class Real>
+inline Double2 load2(const Real* p) {
+  if constexpr (std::is_same_v<Real, double>) {
+    Double2 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  } else {
+    using Float2 = float __attribute__((vector_size(8)));
+    Float2 f;
+    std::memcpy(&f, p, sizeof f);
+    return __builtin_convertvector(f, Double2);
+  }
+}
+
 struct VisitResult {
   int transfers = 0;   // neighbours that received
   double moved = 0.0;  // volume the centre gave, m^3
@@ -158,56 +177,62 @@ struct VisitResult {
 // node is stable). N: stencil size (4 or 8); Gradient: the gradient rule's runs.
 template <int N, bool Gradient, class Store>
 inline VisitResult erosion_visit(Store& store, const ErosionTables& t, std::size_t k, const NodeClass& c) {
+  // Slots in pairs, in SSE2 registers: the same expressions per lane as a scalar loop over the
+  // slots, with no branch per slot. On a contiguous store (HeightGrid) every slot is written,
+  // those that receive nothing with their own height (v = 0: zj + 0 is zj; a missing
+  // neighbour's slot reads and writes the centre, which is written last).
+  constexpr int M = N / 2;
+  constexpr bool kContiguous = requires { store.data(); };
   const double zi = store.z(k);
-  double zj[N];
-  for (int s = 0; s < N; ++s) zj[s] = store.z(k + c.offset[s]);
+  Double2 zj[M], e[M];
   // The rule of common/erosion.hpp (erosion_transfers), unrolled: the edge rule's excess per
   // pair, and with the gradient rule, where the centre's gradient is steeper than tan_settle,
   // the excess along the neighbour's run on the downhill direction where it asks for more.
-  double e[N];
-  double largest = 0.0, sum = 0.0;
-  bool any = false;  // a pair beyond its margin (a stable node returns here, having written nothing)
-  for (int s = 0; s < N; ++s) {
-    const double excess = zi - zj[s] - c.crit[s];
-    const bool over = excess > c.margin[s];
-    any |= over;
-    e[s] = over ? excess : 0.0;
+  for (int h = 0; h < M; ++h) {
+    zj[h] = Double2{store.z(k + c.offset[2 * h]), store.z(k + c.offset[2 * h + 1])};
+    const Double2 excess = zi - zj[h] - load2(&c.crit[2 * h]);
+    e[h] = reinterpret_cast<Double2>(reinterpret_cast<Mask2>(excess) & (excess > load2(&c.margin[2 * h])));
   }
-  if constexpr (!Gradient) {
-    if (!any) return {};
-  } else {
+  if constexpr (Gradient) {
     const double gx = (store.z(k + c.gx_hi) - store.z(k + c.gx_lo)) * c.inv_run_x;
     const double gy = (store.z(k + c.gy_hi) - store.z(k + c.gy_lo)) * c.inv_run_y;
     const double g2 = gx * gx + gy * gy;
-    const bool steep = g2 > t.tan_settle() * t.tan_settle();
-    if (!any && !steep) return {};
-    if (steep) {
+    if (g2 > t.tan_settle() * t.tan_settle()) {
       const double steepness = std::sqrt(g2);
       const double ux = -gx / steepness, uy = -gy / steepness;  // downhill unit vector
       for (int s = 0; s < N; ++s) {
         const double run = c.ox[s] * ux + c.oy[s] * uy;  // 0 for a missing neighbour
         if (!(run > 0.0)) continue;
-        const double along = std::min(zi - zj[s], steepness * run) - run * t.tan_critical();
-        if (along > c.margin[s]) e[s] = std::max(e[s], along);
+        const double along = std::min(zi - zj[s / 2][s % 2], steepness * run) - run * t.tan_critical();
+        if (along > c.margin[s]) e[s / 2][s % 2] = std::max(e[s / 2][s % 2], along);
       }
     }
   }
-  for (int s = 0; s < N; ++s) {
-    e[s] *= c.weight[s];
-    sum += e[s];
-    largest = std::max(largest, e[s]);
+  double sum = 0.0;
+  Double2 largest2 = {0.0, 0.0};
+  for (int h = 0; h < M; ++h) {
+    e[h] *= load2(&c.weight[2 * h]);
+    sum += e[h][0];
+    sum += e[h][1];
+    largest2 = largest2 < e[h] ? e[h] : largest2;  // std::max per lane
   }
   if (!(sum > 0.0)) return {};
+  const double largest = std::max(largest2[0], largest2[1]);
   const double scale = t.fraction() * largest / sum;
   VisitResult r;
   double given = 0.0, error_m3 = 0.0;
-  for (int s = 0; s < N; ++s) {
-    if (!(e[s] > 0.0)) continue;
-    const double v = e[s] * scale;
-    const double err = store.put(k + c.offset[s], zj[s] + v * c.inv_area[s]);
-    if constexpr (Store::kRounds) error_m3 += err * c.area[s];
-    given += v;
-    ++r.transfers;
+  for (int h = 0; h < M; ++h) {
+    const Double2 v = e[h] * scale;
+    const Double2 z_new = zj[h] + v * load2(&c.inv_area[2 * h]);
+    for (int l = 0; l < 2; ++l) {
+      const int s = 2 * h + l;
+      const bool receives = e[h][l] > 0.0;
+      if (!kContiguous && !receives) continue;
+      const double err = store.put(k + c.offset[s], z_new[l]);
+      if constexpr (Store::kRounds) error_m3 += err * c.area[s];  // 0 where nothing was received
+      given += v[l];
+      r.transfers += receives;
+    }
   }
   if constexpr (Store::kRounds) {
     double& carry = store.carry();
@@ -230,25 +255,6 @@ enum class SweepPath { Auto, ActiveSet, Dense, DenseBaseline };
 // the spans from the first to the last member of each row.
 inline bool dense_pass_pays(std::size_t active, std::size_t span_nodes) { return active * 8 >= span_nodes; }
 
-// Heights widened to double (GCC/Clang vector extensions, no FMA, so each lane computes what
-// the scalar code does, bit for bit): two at p[0..1] in one SSE2 register (baseline x86-64),
-// four at p[0..3] in one AVX2 register (only inside functions compiled for AVX2).
-using Double2 = double __attribute__((vector_size(16)));
-using Mask2 = std::int64_t __attribute__((vector_size(16)));
-template <class Real>
-inline Double2 load2(const Real* p) {
-  if constexpr (std::is_same_v<Real, double>) {
-    Double2 v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-  } else {
-    using Float2 = float __attribute__((vector_size(8)));
-    Float2 f;
-    std::memcpy(&f, p, sizeof f);
-    return __builtin_convertvector(f, Double2);
-  }
-}
-
 // Bits of a row's flags, one per node (x at word x / 64, bit x % 64).
 inline bool bit_at(const std::uint64_t* bits, std::size_t x) { return (bits[x / 64] >> (x % 64)) & 1u; }
 // Ors the `count` low bits of `m` in at bit x (count <= 4; may straddle two words).
@@ -256,31 +262,23 @@ inline void or_bits(std::uint64_t* bits, std::size_t x, std::uint64_t m) {
   bits[x / 64] |= m << (x % 64);
   if (x % 64 > 60) bits[x / 64 + 1] |= m >> (64 - x % 64);
 }
-// The first set bit in [from, to], or to + 1 if none. O(words).
-inline std::size_t first_bit(const std::uint64_t* bits, std::size_t from, std::size_t to) {
-  if (from > to) return to + 1;
-  std::size_t w = from / 64;
-  std::uint64_t word = bits[w] & (~std::uint64_t{0} << (from % 64));
-  while (word == 0) {
-    if (++w > to / 64) return to + 1;
-    word = bits[w];
+// Sets bits [a, b].
+inline void set_bits(std::uint64_t* bits, std::size_t a, std::size_t b) {
+  for (std::size_t w = a / 64; w <= b / 64; ++w) {
+    const unsigned lo = w == a / 64 ? a % 64 : 0, hi = w == b / 64 ? b % 64 : 63;
+    bits[w] |= (hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & (~std::uint64_t{0} << lo);
   }
-  const std::size_t x = w * 64 + static_cast<std::size_t>(std::countr_zero(word));
-  return x <= to ? x : to + 1;
 }
-// The last set bit in [from, to] into x (false if none). O(words).
-inline bool last_bit(const std::uint64_t* bits, std::size_t from, std::size_t to, std::size_t& x) {
-  if (from > to) return false;
-  std::size_t w = to / 64;
-  std::uint64_t word = bits[w] & (~std::uint64_t{0} >> (63 - to % 64));
-  while (word == 0) {
-    if (w-- == from / 64) return false;
-    word = bits[w];
-  }
-  x = w * 64 + 63 - static_cast<std::size_t>(std::countl_zero(word));
-  return x >= from;
+// The bits of word w for nodes x in [x0, x1].
+inline std::uint64_t word_range(std::size_t w, std::size_t x0, std::size_t x1) {
+  const unsigned lo = w == x0 / 64 ? x0 % 64 : 0, hi = w == x1 / 64 ? x1 % 64 : 63;
+  return (hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & (~std::uint64_t{0} << lo);
 }
-
+// The bits of word w for nodes x with x % 3 == r (64 = 1 mod 3: the pattern shifts by one per word).
+inline std::uint64_t columns_mod3(std::size_t r, std::size_t w) {
+  constexpr std::uint64_t kEvery3 = 0x9249249249249249ull;  // bits 0, 3, ..., 63
+  return kEvery3 << ((r + 3 - w % 3) % 3);
+}
 // The thresholds of the interior class, copied (the flags could alias the class as far as
 // the compiler knows).
 template <int N>
@@ -418,7 +416,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
   std::vector<std::uint64_t> moved_bits;
   constexpr bool kContiguous = requires { store.data(); };
   // The row's unstable nodes, one bit each (plus a word: or_bits may write one past the row).
-  std::vector<std::uint64_t> flags(kContiguous ? words + 1 : 0, 0);
+  std::vector<std::uint64_t> flags(words + 1, 0);
   const bool avx2 = wide && has_avx2();
   std::size_t prev_lo = 1, prev_hi = 0;  // span of the previous row's transfers (empty)
   std::size_t visited_rows = 0;
@@ -439,71 +437,68 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     prev_lo = 1, prev_hi = 0;
     if (!members && !live) continue;  // a row inside the members' rows with none
     const NodeClass& middle = t.of(nx / 2, iy);
-    // Nodes in [skip_lo, skip_hi] without a flag may be skipped (empty: none may).
-    std::size_t skip_lo = 1, skip_hi = 0;
+    // The nodes of the span that must be visited: on a contiguous store, in an interior row,
+    // the interior nodes classed unstable; every other node of the span. A transfer adds the
+    // nodes within two columns (those that read its writes).
+    std::uint64_t* must = flags.data();
+    std::fill(flags.begin() + static_cast<std::ptrdiff_t>(x0 / 64),
+              flags.begin() + static_cast<std::ptrdiff_t>(x1 / 64 + 2), std::uint64_t{0});
+    std::size_t skip_lo = 1, skip_hi = 0;  // nodes classed (empty: none)
     if constexpr (kContiguous) {
       if (iy > 0 && iy + 1 < ny && nx >= 3) {
         skip_lo = std::max<std::size_t>(1, x0);
         skip_hi = std::min(nx - 2, x1);
         if (skip_lo <= skip_hi) {
-          std::fill(flags.begin() + static_cast<std::ptrdiff_t>(skip_lo / 64),
-                    flags.begin() + static_cast<std::ptrdiff_t>(skip_hi / 64 + 2), std::uint64_t{0});
           const RowThresholds<N> c(middle, t.tan_settle() * t.tan_settle());
           const auto* row = store.data() + iy * nx;
           if (avx2)
-            unstable_bits_avx2<N, Gradient>(row, nx, skip_lo, skip_hi, c, flags.data());
+            unstable_bits_avx2<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
           else
-            unstable_bits<N, Gradient>(row, nx, skip_lo, skip_hi, c, flags.data());
+            unstable_bits<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
         }
       }
+    }
+    if (skip_lo > skip_hi) {
+      set_bits(must, x0, x1);
+    } else {
+      if (x0 < skip_lo) set_bits(must, x0, skip_lo - 1);
+      if (x1 > skip_hi) set_bits(must, skip_hi + 1, x1);
     }
     std::size_t row_lo = nx, row_hi = 0;  // span of this row's transfers (empty)
-    int since_transfer = 3;               // nodes visited since the last one that transferred, in this row
-    std::size_t ix = x_up ? x0 : x1;
-    while (true) {
-      if (since_transfer > 2 && ix >= skip_lo && ix <= skip_hi && !bit_at(flags.data(), ix)) {
-        // Stable, and nothing it reads changed since it was classed: on to the next node that
-        // must be visited (flagged, or outside [skip_lo, skip_hi]), the span's end if none.
-        // (x0 and x1 are still the span's own ends here: they only grow past a transfer.)
-        std::size_t next;
-        bool found;
-        if (x_up) {
-          next = first_bit(flags.data(), ix + 1, skip_hi);
-          found = next <= skip_hi || skip_hi + 1 <= x1;
-        } else {
-          found = last_bit(flags.data(), skip_lo, ix - 1, next) || (skip_lo > x0 && (next = skip_lo - 1, true));
-        }
-        if (!found) {
-          report.updates += x_up ? x1 - ix + 1 : ix - x0 + 1;
-          break;
-        }
-        report.updates += x_up ? next - ix : ix - next;
-        ix = next;
-      }
+    const auto visit = [&](std::size_t ix) {
       const VisitResult v =
           erosion_visit<N, Gradient>(store, t, iy * nx + ix, ix < 2 || ix + 2 >= nx ? t.of(ix, iy) : middle);
-      const bool transferred = v.transfers > 0;
-      if (transferred) {
-        report.transfers += static_cast<std::size_t>(v.transfers);
-        moved += v.moved;
-        moved_row[ix / 64] |= std::uint64_t{1} << (ix % 64);
-        row_lo = std::min(row_lo, ix);
-        row_hi = std::max(row_hi, ix);
-      }
-      since_transfer = transferred ? 0 : since_transfer + 1;
-      ++report.updates;
-      // Next node; past the span's end only while the node at the end transferred (its
-      // block reaches one node further).
-      if (x_up) {
-        if (ix == nx - 1 || (ix >= x1 && !transferred)) break;
-        x1 = std::max(x1, ix + 1);
-        ++ix;
-      } else {
-        if (ix == 0 || (ix <= x0 && !transferred)) break;
-        x0 = std::min(x0, ix - 1);
-        --ix;
+      if (v.transfers == 0) return false;
+      report.transfers += static_cast<std::size_t>(v.transfers);
+      moved += v.moved;
+      moved_row[ix / 64] |= std::uint64_t{1} << (ix % 64);
+      row_lo = std::min(row_lo, ix);
+      row_hi = std::max(row_hi, ix);
+      set_bits(must, ix >= 2 ? ix - 2 : 0, std::min(ix + 2, nx - 1));
+      return true;
+    };
+    // Three phases, one per column modulo 3, each in the sweep's direction.
+    for (std::size_t p = 0; p < 3; ++p) {
+      const std::size_t r = x_up ? (x0 + p) % 3 : (x1 + 3 - p) % 3;
+      for (std::size_t c = 0, cw = x1 / 64 - x0 / 64 + 1; c < cw; ++c) {
+        const std::size_t w = x_up ? x0 / 64 + c : x1 / 64 - c;
+        const std::uint64_t keep = columns_mod3(r, w) & word_range(w, x0, x1);
+        std::uint64_t m = must[w] & keep;
+        while (m != 0) {
+          const auto b = static_cast<unsigned>(x_up ? std::countr_zero(m) : 63 - std::countl_zero(m));
+          const std::uint64_t beyond =  // the bits still ahead of b in the sweep's direction
+              x_up ? (b == 63 ? 0 : ~std::uint64_t{0} << (b + 1)) : (std::uint64_t{1} << b) - 1;
+          m = visit(w * 64 + b) ? must[w] & keep & beyond : m & beyond;
+        }
       }
     }
+    // Past the span's end while the node at the end transferred (its block reaches one node further).
+    if (x_up) {
+      while (x1 + 1 < nx && bit_at(moved_row, x1)) visit(++x1);
+    } else {
+      while (x0 > 0 && bit_at(moved_row, x0)) visit(--x0);
+    }
+    report.updates += x1 - x0 + 1;
     if (row_lo <= row_hi) prev_lo = row_lo, prev_hi = row_hi;
   }
   // Rows in increasing y for the set.
