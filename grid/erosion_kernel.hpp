@@ -244,6 +244,91 @@ inline VisitResult erosion_visit(Store& store, const ErosionTables& t, std::size
   return r;
 }
 
+using Double4 = double __attribute__((vector_size(32)));
+using Mask4 = std::int64_t __attribute__((vector_size(32)));
+template <class Real>
+[[gnu::target("avx2"), gnu::always_inline]] inline Double4 load4(const Real* p) {
+  if constexpr (std::is_same_v<Real, double>) {
+    Double4 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  } else {
+    using Float4 = float __attribute__((vector_size(16)));
+    Float4 f;
+    std::memcpy(&f, p, sizeof f);
+    return __builtin_convertvector(f, Double4);
+  }
+}
+
+// Four interior nodes k, k + 3, k + 6, k + 9 of an interior row of a contiguous store, all of
+// the interior class c, visited at once, one per AVX2 lane. Their 3 x 3 blocks are disjoint,
+// so this is the four visits one after the other, in any order; each lane computes what
+// erosion_visit computes for its node, bit for bit (the same expressions, slot by slot in the
+// same order; AVX2 brings no FMA, so nothing is contracted). The rounding carry (float) is
+// settled lane by lane in visiting order (`reverse`: k + 9 first). Lanes that stay put write
+// their own heights back. Returns the lanes' results in lane order (k first).
+// Heights p[0], p[3], p[6], p[9], widened to double.
+template <class Real>
+[[gnu::target("avx2"), gnu::always_inline]] inline Double4 every3(const Real* p) {
+  return Double4{static_cast<double>(p[0]), static_cast<double>(p[3]), static_cast<double>(p[6]),
+                 static_cast<double>(p[9])};
+}
+template <int N, class Store>
+[[gnu::target("avx2")]] void erosion_visit4(Store& store, const ErosionTables& t, std::size_t k, const NodeClass& c,
+                                            bool reverse, VisitResult out[4]) {
+  const auto* z = store.data() + k;
+  const Double4 zi = every3(z);
+  Double4 zj[N], e[N];
+  Double4 sum = {0.0, 0.0, 0.0, 0.0}, largest = {0.0, 0.0, 0.0, 0.0};
+  for (int s = 0; s < N; ++s) {
+    zj[s] = every3(z + c.offset[s]);
+    const Double4 excess = zi - zj[s] - c.crit[s];
+    e[s] = reinterpret_cast<Double4>(reinterpret_cast<Mask4>(excess) & (excess > c.margin[s]));
+  }
+  for (int s = 0; s < N; ++s) {
+    e[s] *= c.weight[s];
+    sum += e[s];
+    largest = largest < e[s] ? e[s] : largest;
+  }
+  const Mask4 moving = sum > 0.0;
+  for (int l = 0; l < 4; ++l) out[l] = {};
+  if (_mm256_movemask_pd(reinterpret_cast<__m256d>(moving)) == 0) return;
+  const Double4 one = {1.0, 1.0, 1.0, 1.0};
+  const Double4 scale = t.fraction() * largest / (moving ? sum : one);  // 0 where nothing moves
+  Double4 given = {0.0, 0.0, 0.0, 0.0}, error_m3 = {0.0, 0.0, 0.0, 0.0};
+  Mask4 transfers = {0, 0, 0, 0};
+  for (int s = 0; s < N; ++s) {
+    const Double4 v = e[s] * scale;
+    const Double4 z_new = zj[s] + v * c.inv_area[s];
+    if constexpr (Store::kRounds) {
+      // The rounding as put() does it, in one register (written out: GCC 12's SLP vectoriser
+      // turns the four scalar round trips double -> float -> double into the identity).
+      using Float4 = float __attribute__((vector_size(16)));
+      const Float4 stored = __builtin_convertvector(z_new, Float4);
+      for (int l = 0; l < 4; ++l) store.put(k + static_cast<std::size_t>(3 * l + c.offset[s]), stored[l]);
+      error_m3 += (z_new - __builtin_convertvector(stored, Double4)) * c.area[s];  // 0 where nothing was received
+    } else {
+      for (int l = 0; l < 4; ++l) store.put(k + static_cast<std::size_t>(3 * l + c.offset[s]), z_new[l]);
+    }
+    given += v;
+    transfers -= e[s] > 0.0;  // lanes are 0 or -1
+  }
+  if constexpr (Store::kRounds) {
+    double& carry = store.carry();
+    for (int i = 0; i < 4; ++i) {
+      const int l = reverse ? 3 - i : i;
+      if (!moving[l]) continue;
+      carry = store.put(k + static_cast<std::size_t>(3 * l),
+                        zi[l] - given[l] * c.inv_area_i + (carry + error_m3[l]) * c.inv_area_i) *
+              c.area_i;
+    }
+  } else {
+    const Double4 z_centre = zi - given * c.inv_area_i;
+    for (int l = 0; l < 4; ++l) store.put(k + static_cast<std::size_t>(3 * l), z_centre[l]);
+  }
+  for (int l = 0; l < 4; ++l) out[l] = {static_cast<int>(transfers[l]), given[l]};
+}
+
 // Which sweep erode_ordered runs (tests force one; Auto is what the terrains use). Dense
 // sweeps the members' row spans; DenseBaseline is Dense with its rows classed in SSE2
 // registers even where the CPU has AVX2 (tests: both give the same heights, bit for bit).
@@ -269,6 +354,13 @@ inline void set_bits(std::uint64_t* bits, std::size_t a, std::size_t b) {
     bits[w] |= (hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & (~std::uint64_t{0} << lo);
   }
 }
+// Sets bits ix - 2 .. ix + 2 (those below 0 dropped; `bits` must hold bit ix + 2).
+inline void near_bits(std::uint64_t* bits, std::size_t ix) {
+  const std::size_t lo = ix >= 2 ? ix - 2 : 0;
+  const std::uint64_t m = ix >= 2 ? 0x1Fu : 0x1Fu >> (2 - ix);
+  bits[lo / 64] |= m << (lo % 64);
+  if (lo % 64 > 59) bits[lo / 64 + 1] |= m >> (64 - lo % 64);
+}
 // The bits of word w for nodes x in [x0, x1].
 inline std::uint64_t word_range(std::size_t w, std::size_t x0, std::size_t x1) {
   const unsigned lo = w == x0 / 64 ? x0 % 64 : 0, hi = w == x1 / 64 ? x1 % 64 : 63;
@@ -279,6 +371,27 @@ inline std::uint64_t columns_mod3(std::size_t r, std::size_t w) {
   constexpr std::uint64_t kEvery3 = 0x9249249249249249ull;  // bits 0, 3, ..., 63
   return kEvery3 << ((r + 3 - w % 3) % 3);
 }
+// The first node x in [from, to] with x % 3 == r and its bit set (false: none). O(words).
+inline bool next_in_class(const std::uint64_t* bits, std::size_t r, std::size_t from, std::size_t to, std::size_t& x) {
+  if (from > to) return false;
+  for (std::size_t w = from / 64; w <= to / 64; ++w)
+    if (const std::uint64_t m = bits[w] & columns_mod3(r, w) & word_range(w, from, to)) {
+      x = w * 64 + static_cast<std::size_t>(std::countr_zero(m));
+      return true;
+    }
+  return false;
+}
+// The last such node in [from, to].
+inline bool prev_in_class(const std::uint64_t* bits, std::size_t r, std::size_t from, std::size_t to, std::size_t& x) {
+  if (from > to) return false;
+  for (std::size_t w = to / 64 + 1; w-- > from / 64;)
+    if (const std::uint64_t m = bits[w] & columns_mod3(r, w) & word_range(w, from, to)) {
+      x = w * 64 + 63 - static_cast<std::size_t>(std::countl_zero(m));
+      return true;
+    }
+  return false;
+}
+
 // The thresholds of the interior class, copied (the flags could alias the class as far as
 // the compiler knows).
 template <int N>
@@ -338,21 +451,6 @@ void unstable_bits(const Real* z, std::size_t nx, std::size_t x0, std::size_t x1
 // The same, four nodes at a time in AVX2 registers (the same expressions per lane: AVX2
 // brings no FMA, so no contraction; the results are those of unstable_bits bit for bit).
 // Only called where the CPU has AVX2 (has_avx2()).
-using Double4 = double __attribute__((vector_size(32)));
-using Mask4 = std::int64_t __attribute__((vector_size(32)));
-template <class Real>
-[[gnu::target("avx2"), gnu::always_inline]] inline Double4 load4(const Real* p) {
-  if constexpr (std::is_same_v<Real, double>) {
-    Double4 v;
-    std::memcpy(&v, p, sizeof v);
-    return v;
-  } else {
-    using Float4 = float __attribute__((vector_size(16)));
-    Float4 f;
-    std::memcpy(&f, p, sizeof f);
-    return __builtin_convertvector(f, Double4);
-  }
-}
 template <int N, bool Gradient, class Real>
 [[gnu::target("avx2")]] void unstable_bits_avx2(const Real* z, std::size_t nx, std::size_t x0, std::size_t x1,
                                                 const RowThresholds<N>& c, std::uint64_t* out) {
@@ -465,31 +563,46 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       if (x1 > skip_hi) set_bits(must, skip_hi + 1, x1);
     }
     std::size_t row_lo = nx, row_hi = 0;  // span of this row's transfers (empty)
-    const auto visit = [&](std::size_t ix) {
-      const VisitResult v =
-          erosion_visit<N, Gradient>(store, t, iy * nx + ix, ix < 2 || ix + 2 >= nx ? t.of(ix, iy) : middle);
-      if (v.transfers == 0) return false;
+    const auto transferred = [&](std::size_t ix, const VisitResult& v) {
       report.transfers += static_cast<std::size_t>(v.transfers);
       moved += v.moved;
       moved_row[ix / 64] |= std::uint64_t{1} << (ix % 64);
       row_lo = std::min(row_lo, ix);
       row_hi = std::max(row_hi, ix);
-      set_bits(must, ix >= 2 ? ix - 2 : 0, std::min(ix + 2, nx - 1));
-      return true;
+      near_bits(must, ix);
     };
-    // Three phases, one per column modulo 3, each in the sweep's direction.
+    const auto visit = [&](std::size_t ix) {
+      const VisitResult v =
+          erosion_visit<N, Gradient>(store, t, iy * nx + ix, ix < 2 || ix + 2 >= nx ? t.of(ix, iy) : middle);
+      if (v.transfers > 0) transferred(ix, v);
+    };
+    // Three phases, one per column modulo 3, each in the sweep's direction; on a contiguous
+    // store, four nodes of a phase at once where they are interior nodes of the span.
+    const bool in_fours = avx2 && !Gradient && skip_lo <= skip_hi && nx >= 13;
+    const std::size_t four_lo = std::max<std::size_t>(x0, 2), four_hi = std::min(x1, nx - 3);
     for (std::size_t p = 0; p < 3; ++p) {
       const std::size_t r = x_up ? (x0 + p) % 3 : (x1 + 3 - p) % 3;
-      for (std::size_t c = 0, cw = x1 / 64 - x0 / 64 + 1; c < cw; ++c) {
-        const std::size_t w = x_up ? x0 / 64 + c : x1 / 64 - c;
-        const std::uint64_t keep = columns_mod3(r, w) & word_range(w, x0, x1);
-        std::uint64_t m = must[w] & keep;
-        while (m != 0) {
-          const auto b = static_cast<unsigned>(x_up ? std::countr_zero(m) : 63 - std::countl_zero(m));
-          const std::uint64_t beyond =  // the bits still ahead of b in the sweep's direction
-              x_up ? (b == 63 ? 0 : ~std::uint64_t{0} << (b + 1)) : (std::uint64_t{1} << b) - 1;
-          m = visit(w * 64 + b) ? must[w] & keep & beyond : m & beyond;
+      std::size_t from = x_up ? x0 : x1;  // the next node of the phase may be here or beyond
+      std::size_t ix;
+      while (x_up ? next_in_class(must, r, from, x1, ix) : prev_in_class(must, r, x0, from, ix)) {
+        const std::size_t lowest = x_up ? ix : ix - std::min<std::size_t>(ix, 9);
+        if constexpr (kContiguous) {
+          if (in_fours && lowest >= four_lo && lowest + 9 <= four_hi) {
+            VisitResult v[4];
+            erosion_visit4<N>(store, t, iy * nx + lowest, middle, !x_up, v);
+            for (int i = 0; i < 4; ++i) {
+              const int l = x_up ? i : 3 - i;
+              if (v[l].transfers > 0) transferred(lowest + 3 * static_cast<std::size_t>(l), v[l]);
+            }
+            const std::size_t last = x_up ? lowest + 9 : lowest;
+            if (x_up ? last >= x1 : last <= x0) break;
+            from = x_up ? last + 1 : last - 1;
+            continue;
+          }
         }
+        visit(ix);
+        if (x_up ? ix >= x1 : ix <= x0) break;
+        from = x_up ? ix + 1 : ix - 1;
       }
     }
     // Past the span's end while the node at the end transferred (its block reaches one node further).
