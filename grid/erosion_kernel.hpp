@@ -355,24 +355,25 @@ inline void set_bits(std::uint64_t* bits, std::size_t a, std::size_t b) {
   }
 }
 // Sets bits ix - 2 .. ix + 2 (those below 0 dropped; `bits` must hold bit ix + 2).
-inline void near_bits(std::uint64_t* bits, std::size_t ix) {
+[[gnu::always_inline]] inline void near_bits(std::uint64_t* bits, std::size_t ix) {
   const std::size_t lo = ix >= 2 ? ix - 2 : 0;
   const std::uint64_t m = ix >= 2 ? 0x1Fu : 0x1Fu >> (2 - ix);
   bits[lo / 64] |= m << (lo % 64);
   if (lo % 64 > 59) bits[lo / 64 + 1] |= m >> (64 - lo % 64);
 }
 // The bits of word w for nodes x in [x0, x1].
-inline std::uint64_t word_range(std::size_t w, std::size_t x0, std::size_t x1) {
+[[gnu::always_inline]] inline std::uint64_t word_range(std::size_t w, std::size_t x0, std::size_t x1) {
   const unsigned lo = w == x0 / 64 ? x0 % 64 : 0, hi = w == x1 / 64 ? x1 % 64 : 63;
   return (hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & (~std::uint64_t{0} << lo);
 }
 // The bits of word w for nodes x with x % 3 == r (64 = 1 mod 3: the pattern shifts by one per word).
-inline std::uint64_t columns_mod3(std::size_t r, std::size_t w) {
+[[gnu::always_inline]] inline std::uint64_t columns_mod3(std::size_t r, std::size_t w) {
   constexpr std::uint64_t kEvery3 = 0x9249249249249249ull;  // bits 0, 3, ..., 63
   return kEvery3 << ((r + 3 - w % 3) % 3);
 }
 // The first node x in [from, to] with x % 3 == r and its bit set (false: none). O(words).
-inline bool next_in_class(const std::uint64_t* bits, std::size_t r, std::size_t from, std::size_t to, std::size_t& x) {
+[[gnu::always_inline]] inline bool next_in_class(const std::uint64_t* bits, std::size_t r, std::size_t from,
+                                                 std::size_t to, std::size_t& x) {
   if (from > to) return false;
   for (std::size_t w = from / 64; w <= to / 64; ++w)
     if (const std::uint64_t m = bits[w] & columns_mod3(r, w) & word_range(w, from, to)) {
@@ -382,7 +383,8 @@ inline bool next_in_class(const std::uint64_t* bits, std::size_t r, std::size_t 
   return false;
 }
 // The last such node in [from, to].
-inline bool prev_in_class(const std::uint64_t* bits, std::size_t r, std::size_t from, std::size_t to, std::size_t& x) {
+[[gnu::always_inline]] inline bool prev_in_class(const std::uint64_t* bits, std::size_t r, std::size_t from,
+                                                 std::size_t to, std::size_t& x) {
   if (from > to) return false;
   for (std::size_t w = to / 64 + 1; w-- > from / 64;)
     if (const std::uint64_t m = bits[w] & columns_mod3(r, w) & word_range(w, from, to)) {
