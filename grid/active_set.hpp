@@ -131,18 +131,17 @@ class BasicActiveSet {
     const auto centre = [&](std::size_t y, std::size_t w) {
       return y >= y0 && y <= y1 ? centres[(y - y0) * W + w] : std::uint64_t{0};
     };
+    std::vector<std::uint64_t> rows(W + 2, 0);  // centres of rows y - 1..y + 1, ored; a clear word each side
     for (std::size_t y = ya; y <= yb; ++y) {
       std::uint32_t count = 0;
+      for (std::size_t w = 0; w < W; ++w)
+        rows[w + 1] = centre(y, w) | (y > 0 ? centre(y - 1, w) : 0) | (y + 1 < ny_ ? centre(y + 1, w) : 0);
       for (std::size_t w = 0; w < W; ++w) {
         // Rows y - 1, y, y + 1, then one column each way (bits carried across words).
-        const auto rows = [&](std::size_t wi) {
-          return centre(y, wi) | (y > 0 ? centre(y - 1, wi) : 0) | (y + 1 < ny_ ? centre(y + 1, wi) : 0);
-        };
-        const std::uint64_t m = rows(w);
-        const std::uint64_t lo = w > 0 ? rows(w - 1) >> 63 : 0;      // bit 63 of the word before
-        const std::uint64_t hi = w + 1 < W ? rows(w + 1) << 63 : 0;  // bit 0 of the word after
-        std::uint64_t d = m | (m << 1) | lo | (m >> 1) | hi;
+        const std::uint64_t m = rows[w + 1];
+        std::uint64_t d = m | (m << 1) | (rows[w] >> 63) | (m >> 1) | (rows[w + 2] << 63);
         if (w + 1 == W) d &= last_mask;
+        if (d == 0 && bits_[y * W + w] == 0) continue;
         std::uint64_t& word = bits_[y * W + w];
         std::uint64_t kept = word & ~d;  // members not in a block: one more idle visit
         for (std::uint64_t b = kept; b != 0; b &= b - 1) {

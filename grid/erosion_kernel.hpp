@@ -39,19 +39,21 @@
 //
 // Two sweeps (erode_ordered chooses per pass). The active-set sweep visits the members in
 // an alternating, live order (active_set.hpp). The dense pass (dense_pass) visits every node
-// from the first to the last member of each row (its span), in row order, and is taken when
+// from the first to the last member of each row (its span), row after row, and is taken when
 // the members fill at least an eighth of the spans: it first classes a row's nodes with
-// vector arithmetic (reads only)
-// and visits only those that may transfer, which costs about a sixth of an active-set visit
-// per node it skips (instructions, callgrind) and no bookkeeping per visit (the active set
-// is rebuilt word by word after the pass). Both write in place, one node at a time, in a
-// fixed order; the vector part never writes, so both are Gauss-Seidel sweeps with the
+// vector arithmetic (reads only) and visits only those that may transfer, in three phases
+// per row (the columns modulo 3: visits of a phase touch disjoint blocks, so they overlap in
+// the processor and run four at a time in AVX2 lanes), with no bookkeeping per visit (the
+// active set is rebuilt word by word after the pass). Both write in place, one node after
+// the other in a fixed order (four disjoint visits at once are the same as one after the
+// other); the vector classing never writes, so both are Gauss-Seidel sweeps with the
 // conservation above and the energy argument below. They differ in which nodes they visit
 // (the dense pass also visits non-members in the spans; the active-set sweep revisits members
-// activated ahead of it), so their results differ in the order grains stop, not in
-// conservation: measured identical on random rough states (tests/unit/grid_dense_pass_test.cpp)
-// and within the goldens' bounds on the shipped scenes. The choice depends only on the
-// active set, so the dense and sparse grids still compute the same heights bit for bit.
+// activated ahead of it) and in the order within a row, so their results differ in the order
+// grains stop, not in conservation: within a cell of each other on random rough states
+// (tests/unit/grid_dense_pass_test.cpp) and within the goldens' bounds on the shipped scenes.
+// The choice and the order depend only on the active set, so the dense and sparse grids still
+// compute the same heights bit for bit.
 //
 // Energy. Each visit sees the heights left by the visits before it, and moves at most f
 // times the largest pair excess, split in proportion to the pair excesses: for f <= 1 no
@@ -69,8 +71,15 @@
 // but is monotone in energy (no pair inverted) only for f <= 2 / (N + 1), 0.22 with 8
 // neighbours, 0.4 with 4. At the default f = 0.5 an 8-neighbour pit overshoots to
 // -1.25 x (it becomes a peak), so a Jacobi sweep would need a fraction 2.25x smaller, and
-// about that many more passes to settle: the dense pass stays Gauss-Seidel and vectorises
-// only its reads.
+// about that many more passes to settle: the dense pass stays Gauss-Seidel.
+//
+// Why not red-black (four colours). With 8 neighbours, four colours (x mod 2, y mod 2) keep
+// same-colour nodes from being neighbours, but two of them can share a neighbour (a diagonal
+// node has four same-colour neighbours): computed from the same old heights, their transfers
+// into it pile up as in a Jacobi pass with N = 4 senders, monotone only for f <= 2 / 5. Nine
+// colours (x mod 3, y mod 3) give disjoint blocks, so no accumulation and no condition on f;
+// the dense pass uses the row-wise half of that (x mod 3 within a row, rows in order), which
+// keeps the along-y avalanche of a row sweep and is exactly a sequential order.
 //
 // Cost per visit: 9 height loads (4-neighbour: 5), ~6 floating-point operations per
 // neighbour, plus per transfer one division, one store per receiving neighbour and one
@@ -482,25 +491,36 @@ inline bool has_avx2() {
   return yes;
 }
 
-// One dense pass, in place (Gauss-Seidel), in the direction the active set's next sweep
-// would take: in each row, every node from the first to the last member (the row's span)
-// is visited once. Like the active-set sweep it is live: a row's span also covers the nodes
-// next to those that transferred in the row before (the blocks activate_block would have
-// added, so rows beyond the members are reached too), and grows past its end while the node
-// at the end transfers. The active set is then updated word by word (assign_blocks): the
-// blocks of the nodes that transferred become members with a fresh idle count, other
-// members count an idle visit. Same visits, same rule, same conservation as the active-set
-// sweep; what differs is which nodes are visited: every node of the spans, members or not,
-// once (an active-set sweep visits only members, and those activated ahead of it again).
+// One dense pass, in place (Gauss-Seidel), rows in the direction the active set's next
+// sweep would take: in each row, every node from the first to the last member (the row's
+// span) is visited once. Like the active-set sweep it is live: a row's span also covers the
+// nodes next to those that transferred in the row before (the blocks activate_block would
+// have added, so rows beyond the members are reached too), and grows past its end while the
+// node at the end transfers. The active set is then updated word by word (assign_blocks):
+// the blocks of the nodes that transferred become members with a fresh idle count, other
+// members count an idle visit. Same rule, same conservation as the active-set sweep; what
+// differs is which nodes are visited: every node of the spans, members or not, once (an
+// active-set sweep visits only members, and those activated ahead of it again).
+//
+// Order within a row: three phases, the columns x = r (mod 3) for each r in turn, each phase
+// in the sweep's x direction. Nodes three columns apart have disjoint 3 x 3 blocks, so the
+// visits of a phase do not depend on one another: the processor overlaps them, and on a
+// contiguous store with AVX2 four of them (k, k + 3, k + 6, k + 9) run at once, one per lane
+// (erosion_visit4, bit for bit four erosion_visit calls). It is still one visit after the
+// other (Gauss-Seidel, the energy argument above), in a different order from a plain row
+// sweep: an avalanche along x moves up to three nodes per pass in a row instead of the whole
+// run (along y, rows still follow each other). The order depends only on the active set, so
+// every store computes the same heights.
 //
 // Exactness of the shortcut. On a store with contiguous heights (HeightGrid: data()), a
-// row's nodes are first classed by unstable_flags, computed after the previous row is done;
-// a node is then visited only if it is flagged, on a border, or one of the two nodes before
-// it in the row transferred (a visit writes into its 3 x 3 block, which a node up to two
-// columns away reads). Its inputs are otherwise those it was classed with, so skipping it is
-// exactly what its visit would have done: the pass gives the same heights, bit for bit, as
-// visiting every node of the spans (which is what it does on other stores, e.g. the sparse
-// grid).
+// row's interior nodes are first classed by unstable_bits (AVX2: four at a time), after the
+// previous row is done; a node is then visited only if it is flagged, on a border, or within
+// two columns of a node of its row that transferred before it (a visit writes into its 3 x 3
+// block, which a node up to two columns away reads). Its inputs are otherwise those it was
+// classed with, so skipping it is exactly what its visit would have done: the pass gives the
+// same heights, bit for bit, as visiting every node of the spans (which is what it does on
+// other stores, e.g. the sparse grid). `wide` = false classes in SSE2 registers and visits
+// one node at a time (the same heights; tests compare).
 //
 // Cost: O(span nodes) per pass -- the classing vectorised over the row, one visit per
 // unstable node -- plus O(words of the visited rows) to find the spans and update the set.
