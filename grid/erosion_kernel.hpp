@@ -82,13 +82,17 @@
 // keeps the along-y avalanche of a row sweep and is exactly a sequential order.
 //
 // Cost per visit: 9 height loads (4-neighbour: 5), ~6 floating-point operations per
-// neighbour, plus per transfer one division, one store per receiving neighbour and one
-// for the centre; the gradient rule adds a square root and a division per visit. Measured
-// (tests/bench/grid_bench.cpp, callgrind): ~180 instructions per visited node in a dense
-// pass where most visited nodes transfer, ~36 per node to class a row (8 neighbours,
-// double); active-set visits add ~100 for the set's bookkeeping.
-#include <immintrin.h>  // _mm256_movemask_pd, in the AVX2 classing only
-
+// neighbour, plus per transfer one division, and a store per neighbour and one for the
+// centre (on a contiguous store every slot is written: no branch per slot); the gradient rule
+// adds a square root and a division per visit. Measured (tests/bench/grid_bench.cpp,
+// callgrind, edge rule, 8 neighbours), instructions per update (an update: one node of a
+// span or one active-set visit): 109 double / 149 float with every node of 2048^2 active
+// (before the three phases and the AVX2 lanes: 175 / 208), 223 / 283 on grid_bench's pile
+// (307 / 363), 159 / 212 on its stroke (243 / 289). Four visits in AVX2 lanes take ~320
+// instructions (double); classing a row ~16 per node (AVX2, double; ~29 float); rebuilding
+// the active set after a dense pass ~8 per node of the rows. Active-set visits add ~100 for
+// the set's bookkeeping. Float costs more than its instructions: the rounding carry chains
+// every transferring visit to the one before.
 #include <algorithm>
 #include <array>
 #include <bit>
