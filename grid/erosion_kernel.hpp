@@ -108,6 +108,9 @@
 #include "common/terrain.hpp"
 #include "grid/grid_layout.hpp"
 
+// _mm256_movemask_pd, in the AVX2 functions only (compiled for AVX2 by their target attribute).
+#include <immintrin.h>
+
 namespace sb::grid {
 
 // What erosion needs to know about a class of nodes (see above). Slots follow Stencil's
