@@ -72,6 +72,7 @@
 #include "common/terrain.hpp"
 #include "grid/active_set.hpp"
 #include "grid/erosion_kernel.hpp"
+#include "grid/multires_settle.hpp"
 #include "grid/height_grid.hpp"
 #include "grid/stencil.hpp"
 
@@ -102,6 +103,9 @@ class GridTerrain final : public Terrain {
   // runs (default Auto: the dense pass when the members fill an eighth of their row spans).
   void activate_all() { active_.activate_all(); }
   void set_sweep_path(SweepPath path) { sweep_path_ = path; }
+  // Whether large settling budgets start with the multi-resolution cascade (default on;
+  // multires_settle.hpp).
+  void set_multires(bool on) { multires_ = on; }
   const GridLayout& layout() const { return grid_.layout(); }
   const HeightGrid<Real>& heights() const { return grid_; }
   const ActiveSet& active_set() const { return active_; }
@@ -112,6 +116,7 @@ class GridTerrain final : public Terrain {
   Stencil stencil_;
   ActiveSet active_;
   SweepPath sweep_path_ = SweepPath::Auto;
+  bool multires_ = true;
   std::optional<ErosionTables> tables_;  // built on the first erode, rebuilt when the rule changes
 };
 
