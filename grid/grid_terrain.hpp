@@ -72,8 +72,8 @@
 #include "common/terrain.hpp"
 #include "grid/active_set.hpp"
 #include "grid/erosion_kernel.hpp"
-#include "grid/multires_settle.hpp"
 #include "grid/height_grid.hpp"
+#include "grid/multires_settle.hpp"
 #include "grid/stencil.hpp"
 
 namespace sb::grid {

@@ -1,68 +1,79 @@
 #pragma once
 // Multi-resolution settling for the regular grids: a coarse-to-fine cascade that moves sand
 // over long distances on coarse copies of the grid, where a pass is cheap and a distance is
-// few nodes, so that the fine rule only has to finish locally.
+// a few nodes, so that the fine passes only finish what is left at the fine scale.
 //
 // Why. The kernel's relaxation (erosion_kernel.hpp) moves at most half a pair's excess per
 // visit: near the critical angle it behaves like diffusion, and the passes to settle a
 // disturbance of width L grow as (L / h)^2 (flat_stroke.toml: 163, 552, 2077 passes at 2.5,
-// 1.25, 0.625 mm) times an active set that grows as n: settling cost n^2.
+// 1.25, 0.625 mm) times an active set that grows as n: a settling cost of n^2.
 //
 // The cascade (multires_settle). Within a box around the active set (its bounding box,
 // widened by a quarter of its larger side on every side, at least 4 nodes, clipped to the
-// grid), level 1 groups the fine nodes in blocks of 2 x 2 (2 x 1 or 1 x 2 when an axis is
-// too short to halve, a lone node at an odd end), level 2 groups level 1's nodes the same
-// way, and so on while an axis has 16 nodes or more. Each coarse node stands for the sum of
-// its children's areas (per axis, the sum of their trapezoid weights, so A = Wx Wy), lies at
-// their area-weighted centroid, and starts at their area-weighted mean height. Then, from
-// the coarsest level down: the level is relaxed with the fine rule's kernel (erosion_visit:
-// the same rule, fraction and thresholds, with the level's own distances and areas) over its
-// own active set -- the nodes above fine members, and the blocks of those the coarser level
-// changed -- and its height change is injected, piecewise constant, into its children. The
-// fine nodes that changed, and their blocks, join the fine active set, and the fine passes
-// (erode_ordered) finish: the state returned is at repose under the fine rule whenever the
-// fine passes empty the active set, as without the cascade. On flat_stroke.toml the fine
-// passes then only smooth steps of one coarse cell, and the passes to settle no longer grow
-// with the resolution (grid_terrain.hpp has the figures).
+// grid), level 1 groups the fine nodes in blocks of 2 x 2 (2 x 1 or 1 x 2 when an axis has
+// fewer than 16 nodes and is not halved; a lone node at an odd end), level 2 groups level
+// 1's nodes the same way, and so on while an axis has 16 nodes or more. A coarse node
+// stands for the sum of its children's areas (per axis the sum of their weights, so
+// A = Wx Wy), lies at their area-weighted centroid and starts at their area-weighted mean
+// height (block means of block means: the mean of its fine nodes). Then, from the coarsest
+// level to level 1: the level is relaxed with the fine rule's own kernel (erosion_visit: the
+// same rule, fraction and thresholds, with the level's distances and areas,
+// MultiresClasses) over its own active set -- the nodes above active fine nodes, and the
+// blocks of those the coarser level changed -- for at most 512 passes, and its total change
+// dZ_I (relaxed minus restricted height, so it includes what the coarser levels changed) is
+// added to every one of its children. The fine nodes that changed, and their blocks, join
+// the fine active set, and the fine passes (erode_ordered) finish: the state returned is at
+// repose under the fine rule whenever the fine passes empty the active set, as without the
+// cascade.
+//
+// Why piecewise constant. The fine detail under a block (a cut wall, a rim) is kept and only
+// shifted by the block's change; the fine passes then settle the detail locally. Rebuilding
+// the children from the coarse heights instead (a slope per block) replaces detail the fine
+// rule would have kept with flat or bumped blocks below the critical angle, which the rule,
+// moving sand only downhill, never undoes: measured on trench_azimuth.toml (grid, 8
+// neighbours, gradient rule), such rebuilds left the walls at 20-26 degrees instead of 30.
+// Piecewise-constant injection keeps them within 0.02 degrees of the fine passes alone
+// (grid_terrain.hpp has the figures).
 //
 // Conservation. A coarse transfer of V from I to J changes Z_I by -V / A_I and Z_J by
-// V / A_J (the kernel's pairwise transfer, with the level's areas); injection adds dZ_I to
-// every child c of I, which changes the finer volume by sum_c A_c dZ_I = A_I dZ_I, exactly
-// the coarse change, because A_I is the sum of the children's areas. So every level, and the
-// fine grid, keeps its volume up to the rounding of the heights (coarse levels in double; a
-// float fine grid takes the injection through its rounding carry, height_grid.hpp, like any
-// other write).
+// V / A_J (the kernel's pairwise transfer, with the level's areas); adding dZ_I to every
+// child c of I changes the finer volume by sum_c A_c dZ_I = A_I dZ_I, exactly the coarse
+// change, because A_I is the sum of the children's areas. So every level and the fine grid
+// keep their volume up to the rounding of the heights (coarse levels in double; a float
+// fine grid takes the change through its rounding carry, height_grid.hpp, like any write).
 //
-// Energy. With Z_I the area-weighted mean of its children, injecting dZ_I changes the finer
-// level's potential energy sum A z^2 / 2 by sum_c A_c ((z_c + dZ_I)^2 - z_c^2) / 2
-// = A_I Z_I dZ_I + A_I dZ_I^2 / 2: exactly the coarse level's energy change. Each level's
-// relaxation lowers its own energy (the kernel's argument, erosion_kernel.hpp, "Energy":
-// f <= 1, transfers downhill, none inverting a pair), and the relation "coarse = mean of
-// children" holds when a level is relaxed (all levels are restricted from the same fine
-// state, and each injection adds to a level exactly what the coarser level changed). So the
-// fine energy falls by the sum of the levels' falls: it never rises, in exact arithmetic;
-// in floating point up to the rounding of the heights (tests/unit/grid_multires_test.cpp).
-// The conditions: piecewise-constant injection (a bilinear one would need matching weights
-// at the borders), coarse areas the sums of the children's, coarse heights their
-// area-weighted means, f <= 1 (the scene's default 0.5; for f in (1, 2] the kernel contracts
-// pairs without the monotone argument, and so does the cascade).
+// Energy. With Z_I the area-weighted mean of its children, adding dZ_I to them changes the
+// finer level's potential energy sum A z^2 / 2 by sum_c A_c ((z_c + dZ_I)^2 - z_c^2) / 2 =
+// A_I Z_I dZ_I + A_I dZ_I^2 / 2: exactly the coarse level's energy change. Each level's
+// relaxation lowers its own energy (the kernel's argument, erosion_kernel.hpp, "Energy"),
+// and every level is restricted from the same fine state before any level changes, so when
+// a level's change is added its restricted heights are still the means of its children. By
+// induction the fine energy changes by the coarsest level's relaxation plus every other
+// level's: it never rises. Conditions: piecewise-constant injection (a bilinear one would
+// need matching weights, borders included), coarse areas the sums of the children's, coarse
+// heights their area-weighted means, all levels restricted before any is relaxed, and the
+// kernel's own condition (f <= 1 for monotone energy; the scene's default is 0.5). In
+// floating point up to the rounding of the heights (tests/unit/grid_multires_test.cpp).
 //
-// When (multires_pays): only for a budget of 32 passes or more (the runner's settling calls
-// 64; interactive steps and the stroke's steps ask for 4) with no update limit below 8 times
-// the box, and 1024 active nodes or more; interactive budgets therefore stay local and
-// cheap. The cascade depends only on the heights and the active set's members, so the dense
-// and the sparse grid still compute the same heights bit for bit.
+// When (multires_pays, erode_settling): only for a budget of 32 passes or more (the runner's
+// settling asks for 64 at a time; interactive steps and the stroke's steps for 4), an update
+// budget of at least 8 updates per active node, 1024 active nodes or more, and a box of at
+// most (passes x active nodes) nodes, so that restricting it costs no more than the passes
+// it replaces; the cascade runs once per such call (counted as one pass, its coarse visits
+// as updates), then the fine passes use the rest of the budget.
+// Interactive budgets therefore stay local and cheap. The cascade depends only on the
+// heights and the active set's members, so the dense and the sparse grid still compute the
+// same heights bit for bit.
 //
-// Cost: O(box) to restrict, O(visits) on the levels (each level's active set: the nodes
-// above fine members and around changes), O(changed fine nodes) to inject; memory 8 bytes
-// plus the coarse active set's ~2 bytes per coarse node, about a third of the box's nodes
-// in all, freed on return.
+// Cost: O(box) to restrict and inject, plus the levels' visits (each level's active set:
+// the nodes above fine members and around changes); memory per coarse node 8 bytes for the
+// height, 8 for the restricted height, 1 flag and the coarse active set's ~2 bytes, about a
+// third of the box's nodes in all, freed on return. Measured on flat_stroke.toml: see
+// grid_terrain.hpp.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <vector>
 
@@ -101,7 +112,7 @@ struct MultiresLevelReport {
   std::size_t nx = 0, ny = 0;
   int passes = 0;
   std::size_t updates = 0;
-  std::size_t changed = 0;                   // nodes whose height the level changed
+  std::size_t changed = 0;                         // nodes whose height the level changed
   double energy_before = 0.0, energy_after = 0.0;  // sum A z^2 / 2, when measured
 };
 struct MultiresReport {
@@ -116,6 +127,9 @@ struct MultiresReport {
 struct MultiresOptions {
   bool measure_energy = false;  // fill energy_before/after (O(level nodes) each)
   int max_passes_per_level = 512;
+  // No cascade when the box holds more nodes (its O(box) restriction would cost more than
+  // the fine passes it saves).
+  std::size_t max_box_nodes = std::numeric_limits<std::size_t>::max();
 };
 
 // Minimum budget and active set for the cascade (see "When" above).
@@ -182,70 +196,28 @@ inline double level_energy(const Level& l) {
   return e;
 }
 
-// The limited slope of a level's change along one axis at node i: the one-sided difference
-// quotients' minmod (0 at an end, where they differ in sign, or when either is 0).
-inline double minmod_slope(double d_lo, double d_hi, double run_lo, double run_hi) {
-  const double a = d_lo / run_lo, b = d_hi / run_hi;
-  if (!(a * b > 0.0)) return 0.0;
-  return std::abs(a) < std::abs(b) ? a : b;
-}
-
-// Rebuilds the finer level's nodes under the coarse blocks that changed or hold active fine
-// nodes (see "Interpolation" above): each block's children become Z_I + alpha_I g_I . (x_c -
-// xbar_I), g_I the limited slope of the relaxed coarse heights, xbar_I the children's
-// centroid, alpha_I = min(1, sqrt(V_old / V_lin)) with V_old = sum_c A_c (z_c - Zold_I)^2 (the
-// detail it replaces) and V_lin = sum_c A_c (g_I . (x_c - xbar_I))^2. Finer nodes are read with
-// z(i, j) and written with put(i, j, z); changed(i, j) is called for each node written.
-// O(finer nodes).
+// Adds each coarse node's total change (relaxed minus restricted height) to its children in
+// the finer level, read with z(i, j) and written with put(i, j, z); changed(i, j) is called
+// for each node written. O(finer nodes).
 template <class Z, class Put, class Changed>
-void rebuild_blocks(const Level& coarse, const MultiresAxis& fx,
-                    const MultiresAxis& fy, Z&& z, Put&& put, Changed&& changed) {
-  const std::size_t nx = coarse.nx(), ny = coarse.ny();
-  const std::vector<double>& h = coarse.store.h;
-  const std::vector<double>& before = coarse.restricted;
-  std::vector<std::uint8_t> rebuilt(nx * ny, 0);
-  std::vector<double> gx(nx * ny, 0.0), gy(nx * ny, 0.0), v_old(nx * ny, 0.0), v_lin(nx * ny, 0.0);
-  for (std::size_t iy = 0; iy < ny; ++iy)
-    for (std::size_t ix = 0; ix < nx; ++ix) {
-      const std::size_t k = iy * nx + ix;
-      rebuilt[k] = h[k] != before[k] || coarse.fine_active[k];
-      if (!rebuilt[k]) continue;
-      if (ix > 0 && ix + 1 < nx)
-        gx[k] = minmod_slope(h[k] - h[k - 1], h[k + 1] - h[k], coarse.x.position[ix] - coarse.x.position[ix - 1],
-                             coarse.x.position[ix + 1] - coarse.x.position[ix]);
-      if (iy > 0 && iy + 1 < ny)
-        gy[k] = minmod_slope(h[k] - h[k - nx], h[k + nx] - h[k], coarse.y.position[iy] - coarse.y.position[iy - 1],
-                             coarse.y.position[iy + 1] - coarse.y.position[iy]);
-    }
-  const auto linear = [&](std::size_t k, std::size_t i, std::size_t j, std::size_t px, std::size_t py) {
-    return gx[k] * (fx.position[i] - coarse.x.position[px]) + gy[k] * (fy.position[j] - coarse.y.position[py]);
-  };
+void inject_change(const Level& coarse, const MultiresAxis& fx, const MultiresAxis& fy, Z&& z, Put&& put,
+                   Changed&& changed) {
+  const std::size_t nx = coarse.nx();
   for (std::size_t j = 0; j < fy.size(); ++j)
     for (std::size_t i = 0; i < fx.size(); ++i) {
-      const std::size_t px = coarse.x.parent[i], py = coarse.y.parent[j], k = py * nx + px;
-      if (!rebuilt[k]) continue;
-      const double a = fx.weight[i] * fy.weight[j], detail = z(i, j) - before[k], lin = linear(k, i, j, px, py);
-      v_old[k] += a * detail * detail;
-      v_lin[k] += a * lin * lin;
-    }
-  for (std::size_t j = 0; j < fy.size(); ++j)
-    for (std::size_t i = 0; i < fx.size(); ++i) {
-      const std::size_t px = coarse.x.parent[i], py = coarse.y.parent[j], k = py * nx + px;
-      if (!rebuilt[k]) continue;
-      const double alpha = v_lin[k] <= v_old[k] ? 1.0 : std::sqrt(v_old[k] / v_lin[k]);
-      const double v = h[k] + alpha * linear(k, i, j, px, py);
-      if (v == z(i, j)) continue;
-      put(i, j, v);
+      const std::size_t k = coarse.y.parent[j] * nx + coarse.x.parent[i];
+      const double dz = coarse.store.h[k] - coarse.restricted[k];
+      if (dz == 0.0) continue;
+      put(i, j, z(i, j) + dz);
       changed(i, j);
     }
 }
 
 // Relaxes a level over `active` until it is empty or max_passes passes are done.
 template <int N, bool Gradient>
-void relax_level(Level& l, ActiveSet& active, const MultiresClasses& classes, const ErosionTables& t,
-                 int max_passes, MultiresLevelReport& lr, MultiresReport& report) {
+void relax_level(Level& l, ActiveSet& active, const MultiresClasses& classes, const ErosionTables& t, int max_passes,
+                 MultiresLevelReport& lr, MultiresReport& report) {
   const std::size_t nx = l.nx();
-  if (std::getenv("SB_MR_DEBUG2")) std::fprintf(stderr, "[%zu] ", active.size());
   while (!active.empty() && lr.passes < max_passes) {
     ++lr.passes;
     lr.updates += active.sweep(std::numeric_limits<std::size_t>::max(), [&](std::size_t ix, std::size_t iy) {
@@ -256,9 +228,7 @@ void relax_level(Level& l, ActiveSet& active, const MultiresClasses& classes, co
       active.activate_block(ix, iy);
       return true;
     });
-    if (std::getenv("SB_MR_DEBUG2")) std::fprintf(stderr, "%zu ", active.size());
   }
-  if (std::getenv("SB_MR_DEBUG2")) std::fprintf(stderr, "\n");
   report.updates += lr.updates;
 }
 
@@ -283,6 +253,7 @@ MultiresReport multires_settle(Store& store, Active& active, const ErosionTables
   Box box;
   if (!settle_box(active, layout, box)) return report;
   report.box_nodes = box.nx() * box.ny();
+  if (report.box_nodes > options.max_box_nodes) return report;
   constexpr std::size_t kHalveFrom = 16;  // an axis with fewer nodes is not halved
   const auto coarser = [](const MultiresAxis& a) { return MultiresAxis::coarsen(a, a.size() >= kHalveFrom); };
 
@@ -301,8 +272,7 @@ MultiresReport multires_settle(Store& store, Active& active, const ErosionTables
   // Levels 1..L, restricted from the fine heights: block means Z_I = sum_c A_c z_c / A_I,
   // each level from the finer one.
   std::vector<Level> levels;
-  const auto restrict_from = [](Level& c, const MultiresAxis& x, const MultiresAxis& y, auto&& z_of,
-                                auto&& active_of) {
+  const auto restrict_from = [](Level& c, const MultiresAxis& x, const MultiresAxis& y, auto&& z_of, auto&& active_of) {
     c.store.h.assign(c.nx() * c.ny(), 0.0);
     c.fine_active.assign(c.nx() * c.ny(), 0);
     for (std::size_t j = 0; j < y.size(); ++j)
@@ -329,7 +299,7 @@ MultiresReport multires_settle(Store& store, Active& active, const ErosionTables
     levels.push_back(std::move(c));
   }
 
-  // Coarsest to finest: relax, then interpolate the change into the finer level.
+  // Coarsest to finest: relax, then add the level's change to the finer level.
   std::vector<std::uint8_t> changed_from_coarser;  // per node of the current level
   for (std::size_t li = levels.size(); li-- > 0;) {
     Level& l = levels[li];
@@ -349,29 +319,19 @@ MultiresReport multires_settle(Store& store, Active& active, const ErosionTables
     if (options.measure_energy) lr.energy_before = level_energy(l);
     relax_level<N, Gradient>(l, level_active, classes, t, options.max_passes_per_level, lr, report);
     if (options.measure_energy) lr.energy_after = level_energy(l);
-    if (std::getenv("SB_MR_DEBUG3")) {
-      std::fprintf(stderr, "level %zu row: ", l.nx());
-      for (std::size_t ix = 0; ix < l.nx(); ++ix) {
-        const double z0 = before[(l.ny() / 2) * l.nx() + ix], z1 = l.store.h[(l.ny() / 2) * l.nx() + ix];
-        if ((std::abs(z0 - 0.1) > 1e-9 && std::abs(z0 - 0.09) > 1e-9) || z0 != z1)
-          std::fprintf(stderr, "%.1f:%.3f>%.3f ", l.x.position[ix] * 1e3, z0 * 1e3 - 90, z1 * 1e3 - 90);
-      }
-      std::fprintf(stderr, "\n");
-    }
     for (std::size_t k = 0; k < before.size(); ++k) lr.changed += l.store.h[k] != before[k] ? 1 : 0;
     report.levels.insert(report.levels.begin(), lr);
     if (li > 0) {  // into the finer coarse level
       Level& f = levels[li - 1];
       changed_from_coarser.assign(f.nx() * f.ny(), 0);
-      rebuild_blocks(
+      inject_change(
           l, f.x, f.y, [&](std::size_t i, std::size_t j) { return f.store.h[j * f.nx() + i]; },
           [&](std::size_t i, std::size_t j, double v) { f.store.h[j * f.nx() + i] = v; },
           [&](std::size_t i, std::size_t j) { changed_from_coarser[j * f.nx() + i] = 1; });
       continue;
     }
-    rebuild_blocks(  // into the fine grid
-        l, fx, fy,
-        [&](std::size_t i, std::size_t j) { return store.z((box.y0 + j) * layout.nx + box.x0 + i); },
+    inject_change(  // into the fine grid
+        l, fx, fy, [&](std::size_t i, std::size_t j) { return store.z((box.y0 + j) * layout.nx + box.x0 + i); },
         [&](std::size_t i, std::size_t j, double v) {
           const std::size_t k = (box.y0 + j) * layout.nx + box.x0 + i;
           if constexpr (Store::kRounds) {
@@ -410,17 +370,13 @@ ErosionReport erode_settling(Store& store, Active& active, const ErosionTables& 
                              SweepPath path, bool multires) {
   if (!multires || path != SweepPath::Auto || !multires_pays(active, budget))
     return erode_ordered(store, active, t, budget, path);
-  const MultiresReport m = multires_settle(store, active, t);
+  MultiresOptions options;
+  options.max_box_nodes = static_cast<std::size_t>(budget.max_passes) * active.size();
+  const MultiresReport m = multires_settle(store, active, t, options);
   ErosionBudget rest = budget;
   rest.max_passes -= 1;
   rest.max_updates -= std::min(rest.max_updates, m.updates);
   ErosionReport r = erode_ordered(store, active, t, rest, path);
-  if (std::getenv("SB_MR_DEBUG")) {
-    std::fprintf(stderr, "multires box %zu fine_changed %zu coarse updates %zu; fine passes %d updates %zu active %zu\n",
-                 m.box_nodes, m.fine_changed, m.updates, r.passes, r.updates, r.active);
-    for (const auto& l : m.levels)
-      std::fprintf(stderr, "  level %zux%zu passes %d updates %zu changed %zu\n", l.nx, l.ny, l.passes, l.updates, l.changed);
-  }
   r.passes += 1;
   r.updates += m.updates;
   r.transfers += m.transfers;
