@@ -373,6 +373,7 @@ ErosionReport erode_settling(Store& store, Active& active, const ErosionTables& 
   MultiresOptions options;
   options.max_box_nodes = static_cast<std::size_t>(budget.max_passes) * active.size();
   const MultiresReport m = multires_settle(store, active, t, options);
+  if (m.levels.empty()) return erode_ordered(store, active, t, budget, path);  // no coarse level, or too large a box
   ErosionBudget rest = budget;
   rest.max_passes -= 1;
   rest.max_updates -= std::min(rest.max_updates, m.updates);
