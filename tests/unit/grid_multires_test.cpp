@@ -22,37 +22,26 @@
 #include "grid/grid_terrain.hpp"
 #include "grid/multires_settle.hpp"
 #include "grid/sparse_terrain.hpp"
+#include "grid_rough_states.hpp"
 
 namespace sb::grid {
 namespace {
 
 constexpr double kCell = 0.005;
 
-// Sand 0.1 m deep, rough by up to +-1.5 cells per node, with a pit 3 cm deep over the middle
-// third of the domain: its walls collapse over many cells.
+// Sand 0.1 m deep, rough by up to +-1.5 cells per node (test::rough_height), with a pit 3 cm
+// deep over the middle third of the domain: its walls collapse over many cells.
 double rough_pit(const Vec2& p, const Aabb2& box, std::uint64_t seed) {
-  std::uint64_t h = seed * 0x9E3779B97F4A7C15ull ^
-                    static_cast<std::uint64_t>(std::llround(p.x() * 1e4)) * 0xBF58476D1CE4E5B9ull ^
-                    static_cast<std::uint64_t>(std::llround(p.y() * 1e4)) * 0x94D049BB133111EBull;
-  h ^= h >> 31;
-  h *= 0xD6E8FEB86639EB69ull;
-  h ^= h >> 29;
-  const double u = static_cast<double>(h >> 11) / 9007199254740992.0;  // [0, 1)
   const Vec2 size = box.hi - box.lo;
   const Vec2 rel(p.x() - box.lo.x(), p.y() - box.lo.y());
   const bool pit = std::abs(rel.x() - size.x() / 2) <= size.x() / 6 && std::abs(rel.y() - size.y() / 2) <= size.y() / 6;
-  return 0.1 + (u - 0.5) * 3.0 * kCell - (pit ? 0.03 : 0.0);
+  return test::rough_height(p, seed, kCell) - (pit ? 0.03 : 0.0);
 }
 
 // nx x ny nodes on the 5 mm grid.
 GridLayout layout_of(std::size_t nx, std::size_t ny) {
   return GridLayout::covering({{0.0, 0.0}, {kCell * static_cast<double>(nx - 1), kCell * static_cast<double>(ny - 1)}},
                               kCell);
-}
-
-ErosionRule rule_for(ErosionRuleKind kind) {
-  Material m;  // 30 degrees, fraction 0.5
-  return ErosionRule::from(m, 0.1, kind);
 }
 
 template <class Grid>
@@ -67,15 +56,9 @@ double energy(const Grid& g) {
   return e;
 }
 
-struct Case {
-  ErosionRuleKind rule;
-  int neighbours;
-  bool is_float;
-};
-
-std::string name(const Case& c) {
-  return std::string(to_string(c.rule)) + "_" + std::to_string(c.neighbours) + (c.is_float ? "_float" : "_double");
-}
+using Case = test::ErosionCase;
+using test::name;
+using test::rule_for;
 
 struct Size {
   std::size_t nx, ny;
@@ -178,12 +161,7 @@ TEST_P(Multires, SettlesToReposeUnderTheFineRuleLikeTheSparseGrid) {
     settles_to_repose_like_the_sparse_grid<double>();
 }
 
-INSTANTIATE_TEST_SUITE_P(RulesStencilsStorage, Multires,
-                         ::testing::Values(Case{ErosionRuleKind::Edge, 8, false}, Case{ErosionRuleKind::Edge, 4, false},
-                                           Case{ErosionRuleKind::Gradient, 8, false},
-                                           Case{ErosionRuleKind::Gradient, 4, false},
-                                           Case{ErosionRuleKind::Edge, 8, true},
-                                           Case{ErosionRuleKind::Gradient, 4, true}),
+INSTANTIATE_TEST_SUITE_P(RulesStencilsStorage, Multires, test::erosion_cases(),
                          [](const ::testing::TestParamInfo<Case>& info) { return name(info.param); });
 
 // The cascade takes far fewer passes than the fine passes alone on a 121 x 121 pit, and
