@@ -3,8 +3,9 @@
 // double.
 //   - The dense pass's shortcut (rows classed several nodes at a time, stable nodes skipped)
 //     is exact: the dense grid (which takes it) and the sparse grid (which visits every node)
-//     give the same heights bit for bit, with the rows classed in AVX2 registers (where the
-//     CPU has them) or in SSE2 registers (SweepPath::DenseBaseline).
+//     give the same heights bit for bit, with the rows classed in AVX2 registers and four
+//     nodes visited at once in AVX2 lanes (where the CPU has them) or classed in SSE2
+//     registers and visited one at a time (SweepPath::DenseBaseline); also on wide rows.
 //   - Dense and active-set paths conserve volume exactly (reported changes against volume()),
 //     both settle, and reach surfaces within a small height tolerance of each other.
 #include <gtest/gtest.h>
@@ -33,18 +34,24 @@ using Case = test::ErosionCase;
 using test::name;
 using test::rule_for;
 
+// A wide one: 141 x 23 nodes, rows of three words, so the bit scans and the four-node visits
+// cross word boundaries.
+const GridLayout kWide = GridLayout::covering({{0.0, 0.0}, {0.7, 0.11}}, kCell);
+
 template <class T>
 std::vector<double> heights_of(const T& t) {
+  const GridLayout& g = t.heights().layout();
   std::vector<double> z;
-  for (std::size_t iy = 0; iy < kLayout.ny; ++iy)
-    for (std::size_t ix = 0; ix < kLayout.nx; ++ix) z.push_back(t.heights().z(ix, iy));
+  for (std::size_t iy = 0; iy < g.ny; ++iy)
+    for (std::size_t ix = 0; ix < g.nx; ++ix) z.push_back(t.heights().z(ix, iy));
   return z;
 }
 
 template <class T>
-std::unique_ptr<T> rough_terrain(const Case& c, std::uint64_t seed, SweepPath path) {
+std::unique_ptr<T> rough_terrain(const Case& c, std::uint64_t seed, SweepPath path,
+                                 const GridLayout& layout = kLayout) {
   auto t = std::make_unique<T>(
-      kLayout, [seed](const Vec2& p) { return rough(p, seed); }, c.neighbours, 2);
+      layout, [seed](const Vec2& p) { return rough(p, seed); }, c.neighbours, 2);
   t->activate_all();
   t->set_sweep_path(path);
   return t;
@@ -53,15 +60,19 @@ std::unique_ptr<T> rough_terrain(const Case& c, std::uint64_t seed, SweepPath pa
 class DensePass : public ::testing::TestWithParam<Case> {
  protected:
   template <class Real>
-  void shortcut_is_exact() {
+  void shortcut_is_exact(const GridLayout& layout = kLayout) {
     const Case& c = GetParam();
     const ErosionRule rule = rule_for(c.rule);
     for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-      auto dense = rough_terrain<GridTerrain<Real>>(c, seed, SweepPath::Dense);
-      auto plain = rough_terrain<SparseGridTerrain<Real>>(c, seed, SweepPath::Dense);
-      auto narrow = rough_terrain<GridTerrain<Real>>(c, seed, SweepPath::DenseBaseline);  // SSE2 classing
+      auto dense = rough_terrain<GridTerrain<Real>>(c, seed, SweepPath::Dense, layout);
+      auto plain = rough_terrain<SparseGridTerrain<Real>>(c, seed, SweepPath::Dense, layout);
+      // SSE2 classing, one node at a time
+      auto narrow = rough_terrain<GridTerrain<Real>>(c, seed, SweepPath::DenseBaseline, layout);
+      const double v0 = dense->volume();
+      double tracked = v0;
       for (int call = 0; call < 5; ++call) {
         const ErosionReport a = dense->erode(rule, {.max_passes = 3});
+        tracked += a.volume_change_m3;
         const ErosionReport b = plain->erode(rule, {.max_passes = 3});
         const ErosionReport n = narrow->erode(rule, {.max_passes = 3});
         EXPECT_EQ(a.transfers, b.transfers);
@@ -78,6 +89,7 @@ class DensePass : public ::testing::TestWithParam<Case> {
       }
       EXPECT_EQ(differing, 0u) << "seed " << seed;
       EXPECT_EQ(differing_narrow, 0u) << "seed " << seed;
+      EXPECT_NEAR(tracked, dense->volume(), (c.is_float ? 1e-12 : 1e-14) * v0);  // transfers conserve volume
       EXPECT_TRUE(dense->check().ok());
     }
   }
@@ -128,6 +140,13 @@ TEST_P(DensePass, ShortcutGivesThePlainSweepBitForBit) {
     shortcut_is_exact<double>();
 }
 
+TEST_P(DensePass, ShortcutGivesThePlainSweepBitForBitOnWideRows) {
+  if (GetParam().is_float)
+    shortcut_is_exact<float>(kWide);
+  else
+    shortcut_is_exact<double>(kWide);
+}
+
 TEST_P(DensePass, ConservesAndSettlesCloseToTheActiveSetPath) {
   if (GetParam().is_float)
     paths_agree<float>();
@@ -136,6 +155,9 @@ TEST_P(DensePass, ConservesAndSettlesCloseToTheActiveSetPath) {
 }
 
 INSTANTIATE_TEST_SUITE_P(RulesStencilsStorage, DensePass, test::erosion_cases(),
+                         [](const ::testing::TestParamInfo<Case>& info) { return name(info.param); });
+// The edge rule, 4 neighbours, float (the four-node visits with rounding, on the smaller stencil).
+INSTANTIATE_TEST_SUITE_P(EdgeFourFloat, DensePass, ::testing::Values(Case{ErosionRuleKind::Edge, 4, true}),
                          [](const ::testing::TestParamInfo<Case>& info) { return name(info.param); });
 
 // The dense pass keeps the active set word by word: the same members as activate_block per
