@@ -193,21 +193,17 @@ struct VisitResult {
 // node is stable). N: stencil size (4 or 8); Gradient: the gradient rule's runs.
 template <int N, bool Gradient, class Store>
 inline VisitResult erosion_visit(Store& store, const ErosionTables& t, std::size_t k, const NodeClass& c) {
-  // Slots in pairs, in SSE2 registers: the same expressions per lane as a scalar loop over the
-  // slots, with no branch per slot. On a contiguous store (HeightGrid) every slot is written,
-  // those that receive nothing with their own height (v = 0: zj + 0 is zj; a missing
-  // neighbour's slot reads and writes the centre, which is written last).
-  constexpr int M = N / 2;
-  constexpr bool kContiguous = requires { store.data(); };
   const double zi = store.z(k);
-  Double2 zj[M], e[M];
+  double zj[N];
+  for (int s = 0; s < N; ++s) zj[s] = store.z(k + c.offset[s]);
   // The rule of common/erosion.hpp (erosion_transfers), unrolled: the edge rule's excess per
   // pair, and with the gradient rule, where the centre's gradient is steeper than tan_settle,
   // the excess along the neighbour's run on the downhill direction where it asks for more.
-  for (int h = 0; h < M; ++h) {
-    zj[h] = Double2{store.z(k + c.offset[2 * h]), store.z(k + c.offset[2 * h + 1])};
-    const Double2 excess = zi - zj[h] - load2(&c.crit[2 * h]);
-    e[h] = reinterpret_cast<Double2>(reinterpret_cast<Mask2>(excess) & (excess > load2(&c.margin[2 * h])));
+  double e[N];
+  double largest = 0.0, sum = 0.0;
+  for (int s = 0; s < N; ++s) {
+    const double excess = zi - zj[s] - c.crit[s];
+    e[s] = excess > c.margin[s] ? excess : 0.0;
   }
   if constexpr (Gradient) {
     const double gx = (store.z(k + c.gx_hi) - store.z(k + c.gx_lo)) * c.inv_run_x;
@@ -219,36 +215,27 @@ inline VisitResult erosion_visit(Store& store, const ErosionTables& t, std::size
       for (int s = 0; s < N; ++s) {
         const double run = c.ox[s] * ux + c.oy[s] * uy;  // 0 for a missing neighbour
         if (!(run > 0.0)) continue;
-        const double along = std::min(zi - zj[s / 2][s % 2], steepness * run) - run * t.tan_critical();
-        if (along > c.margin[s]) e[s / 2][s % 2] = std::max(e[s / 2][s % 2], along);
+        const double along = std::min(zi - zj[s], steepness * run) - run * t.tan_critical();
+        if (along > c.margin[s]) e[s] = std::max(e[s], along);
       }
     }
   }
-  double sum = 0.0;
-  Double2 largest2 = {0.0, 0.0};
-  for (int h = 0; h < M; ++h) {
-    e[h] *= load2(&c.weight[2 * h]);
-    sum += e[h][0];
-    sum += e[h][1];
-    largest2 = largest2 < e[h] ? e[h] : largest2;  // std::max per lane
+  for (int s = 0; s < N; ++s) {
+    e[s] *= c.weight[s];
+    sum += e[s];
+    largest = std::max(largest, e[s]);
   }
   if (!(sum > 0.0)) return {};
-  const double largest = std::max(largest2[0], largest2[1]);
   const double scale = t.fraction() * largest / sum;
   VisitResult r;
   double given = 0.0, error_m3 = 0.0;
-  for (int h = 0; h < M; ++h) {
-    const Double2 v = e[h] * scale;
-    const Double2 z_new = zj[h] + v * load2(&c.inv_area[2 * h]);
-    for (int l = 0; l < 2; ++l) {
-      const int s = 2 * h + l;
-      const bool receives = e[h][l] > 0.0;
-      if (!kContiguous && !receives) continue;
-      const double err = store.put(k + c.offset[s], z_new[l]);
-      if constexpr (Store::kRounds) error_m3 += err * c.area[s];  // 0 where nothing was received
-      given += v[l];
-      r.transfers += receives;
-    }
+  for (int s = 0; s < N; ++s) {
+    if (!(e[s] > 0.0)) continue;
+    const double v = e[s] * scale;
+    const double err = store.put(k + c.offset[s], zj[s] + v * c.inv_area[s]);
+    if constexpr (Store::kRounds) error_m3 += err * c.area[s];
+    given += v;
+    ++r.transfers;
   }
   if constexpr (Store::kRounds) {
     double& carry = store.carry();
