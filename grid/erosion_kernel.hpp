@@ -587,7 +587,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       row_hi = std::max(row_hi, ix);
       near_bits(must, ix);
     };
-    const auto visit = [&](std::size_t ix) {
+    const auto visit = [&](std::size_t ix) __attribute__((flatten)) {  // the store's reads and writes inlined
       const VisitResult v =
           erosion_visit<N, Gradient>(store, t, iy * nx + ix, ix < 2 || ix + 2 >= nx ? t.of(ix, iy) : middle);
       if (v.transfers > 0) transferred(ix, v);
