@@ -82,9 +82,9 @@
 // keeps the along-y avalanche of a row sweep and is exactly a sequential order.
 //
 // Cost per visit: 9 height loads (4-neighbour: 5), ~6 floating-point operations per
-// neighbour, plus per transfer one division, and a store per neighbour and one for the
-// centre (on a contiguous store every slot is written: no branch per slot); the gradient rule
-// adds a square root and a division per visit. Measured (tests/bench/grid_bench.cpp,
+// neighbour, plus per transfer one division, and a store per receiving neighbour and one
+// for the centre (four visits in AVX2 lanes write every slot: no branch per slot); the
+// gradient rule adds a square root and a division per visit. Measured (tests/bench/grid_bench.cpp,
 // callgrind, edge rule, 8 neighbours), instructions per update (an update: one node of a
 // span or one active-set visit): 109 double / 149 float with every node of 2048^2 active
 // (before the three phases and the AVX2 lanes: 175 / 208), 223 / 283 on grid_bench's pile
