@@ -86,9 +86,9 @@
 // for the centre (four visits in AVX2 lanes write every slot: no branch per slot); the
 // gradient rule adds a square root and a division per visit. Measured (tests/bench/grid_bench.cpp,
 // callgrind, edge rule, 8 neighbours), instructions per update (an update: one node of a
-// span or one active-set visit): 109 double / 149 float with every node of 2048^2 active
-// (before the three phases and the AVX2 lanes: 175 / 208), 223 / 283 on grid_bench's pile
-// (307 / 363), 159 / 212 on its stroke (243 / 289). Four visits in AVX2 lanes take ~320
+// span or one active-set visit): 111 double / 150 float with every node of 2048^2 active
+// (before the three phases and the AVX2 lanes: 175 / 208), 222 / 281 on grid_bench's pile
+// (307 / 363), 160 / 213 on its stroke (243 / 289). Four visits in AVX2 lanes take ~320
 // instructions (double); classing a row ~16 per node (AVX2, double; ~29 float); rebuilding
 // the active set after a dense pass ~8 per node of the rows. Active-set visits add ~100 for
 // the set's bookkeeping. Float costs more than its instructions: the rounding carry chains
