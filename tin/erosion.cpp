@@ -15,20 +15,13 @@ double TinTerrain::gather_neighbours(VertexHandle v) {
   vertex_scratch_.clear();
   nbr_scratch_.clear();
   const Point& p = v->point();
-  // The vertex circulator's walk, unrolled (same start and counter-clockwise order): this is
-  // the hottest loop of a step.
-  const VertexHandle infinite = cdt_.infinite_vertex();
-  const FaceHandle start = v->face();
-  FaceHandle f = start;
-  do {
-    const int i = Cdt::ccw(f->index(v));
-    const VertexHandle w = f->vertex(i);
-    f = f->neighbor(i);
-    if (w == infinite) continue;
+  // The hottest loop of a step: the ring comes from the cache (its walk is repeated only when
+  // v's star changed), heights and areas are read fresh.
+  for (const VertexHandle w : ring_of(v)) {
     vertex_scratch_.push_back(w);
     const double ex = w->point().x() - p.x(), ey = w->point().y() - p.y();
     nbr_scratch_.push_back({w->point().z(), std::sqrt(ex * ex + ey * ey), cached_area(w), ex, ey});
-  } while (f != start);
+  }
   return cached_area(v);
 }
 
@@ -93,7 +86,8 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
   for (int pass = 0; pass < budget.max_passes && !erosion_list_.empty() && report.updates < budget.max_updates;
        ++pass) {
     ++report.passes;
-    work.assign(erosion_list_.begin(), erosion_list_.end());
+    work.clear();
+    for (const ErosionEntry& e : erosion_list_) work.push_back(e.vertex);
     for (VertexHandle v : work) {
       if (report.updates >= budget.max_updates) break;
       if (v->info().erosion_slot == kNoSlot) continue;
@@ -147,6 +141,15 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
         }
       }
     }
+  }
+  // A settling region leaves L_e, and its rings become garbage: give the memory back (all of
+  // it, with L_e's, once everything has settled).
+  if (erosion_list_.empty()) {
+    std::vector<ErosionEntry>().swap(erosion_list_);
+    std::vector<VertexHandle>().swap(ring_pool_);
+    ring_pool_live_ = 0;
+  } else if (ring_pool_.capacity() > 256 && 4 * ring_pool_live_ < ring_pool_.capacity()) {
+    compact_ring_pool(2 * ring_pool_live_);
   }
   report.active = erosion_list_.size();
   return report;
