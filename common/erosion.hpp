@@ -98,7 +98,7 @@ inline SurfaceGradient fan_gradient(double z_i, std::span<const ErosionNeighbour
   const std::size_t n = ring.size();
   for (std::size_t a = 0; a < n && n >= 2; ++a) {
     const ErosionNeighbour& j = ring[a];
-    const ErosionNeighbour& k = ring[(a + 1) % n];
+    const ErosionNeighbour& k = ring[a + 1 < n ? a + 1 : 0];  // (no division in the hot loop)
     const double cross = j.dx * k.dy - j.dy * k.dx;
     if (!(cross > 1e-9 * j.distance * k.distance)) continue;
     const double hj = j.z - z_i, hk = k.z - z_i;

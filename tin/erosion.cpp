@@ -12,15 +12,16 @@
 namespace sb::tin::detail {
 
 double TinTerrain::gather_neighbours(VertexHandle v) {
-  vertex_scratch_.clear();
-  nbr_scratch_.clear();
   const Point& p = v->point();
   // The hottest loop of a step: the ring comes from the cache (its walk is repeated only when
   // v's star changed), heights and areas are read fresh.
-  for (const VertexHandle w : ring_of(v)) {
-    vertex_scratch_.push_back(w);
-    const double ex = w->point().x() - p.x(), ey = w->point().y() - p.y();
-    nbr_scratch_.push_back({w->point().z(), std::sqrt(ex * ex + ey * ey), cached_area(w), ex, ey});
+  const std::span<const VertexHandle> ring = ring_of(v);
+  vertex_scratch_.assign(ring.begin(), ring.end());
+  nbr_scratch_.resize(ring.size());
+  for (std::size_t k = 0; k < ring.size(); ++k) {
+    const Point& q = ring[k]->point();
+    const double ex = q.x() - p.x(), ey = q.y() - p.y();
+    nbr_scratch_[k] = {q.z(), std::sqrt(ex * ex + ey * ey), cached_area(ring[k]), ex, ey};
   }
   return cached_area(v);
 }

@@ -279,12 +279,6 @@ double TinTerrain::vertex_area(VertexHandle v) const {
   return area / 3.0;
 }
 
-double TinTerrain::cached_area(VertexHandle v) const {
-  VertexInfo& in = v->info();
-  if (in.area < 0.0) in.area = vertex_area(v);
-  return in.area;
-}
-
 void TinTerrain::forget_star(VertexHandle v) {
   forget_caches(v);
   auto c = cdt_.incident_vertices(v), done = c;
@@ -439,14 +433,6 @@ void TinTerrain::collect_vertices(const Aabb2& box, std::vector<VertexHandle>& o
       queue.push_back(n);
     }
   }
-}
-
-void TinTerrain::touch(VertexHandle v) {
-  VertexInfo& in = v->info();
-  in.idle = 0;
-  if (in.erosion_slot != kNoSlot) return;
-  in.erosion_slot = static_cast<std::uint32_t>(erosion_list_.size());
-  erosion_list_.push_back(ErosionEntry{v});
 }
 
 void TinTerrain::touch_with_neighbours(VertexHandle v) {

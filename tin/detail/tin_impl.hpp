@@ -173,7 +173,11 @@ class TinTerrain final : public Terrain {
   // The cached area (computed when stale); and forgetting the caches of v and its neighbours,
   // whose stars change when v's does. Every change of the triangulation goes through
   // insert_point, remove_vertex, or a stamp, which forget the caches of the region they touched.
-  double cached_area(VertexHandle v) const;
+  double cached_area(VertexHandle v) const {  // inline: erosion reads it for every neighbour
+    VertexInfo& in = v->info();
+    if (in.area < 0.0) in.area = vertex_area(v);
+    return in.area;
+  }
   void forget_star(VertexHandle v);
   // v's cached area, short-edge flag and ring forgotten: its star changed.
   void forget_caches(VertexHandle v) {
@@ -187,7 +191,13 @@ class TinTerrain final : public Terrain {
   CaptureResult end_capture(Capture& c, std::vector<VertexHandle>* region_vertices = nullptr);
   // Vertices inside `box` (a traversal of the faces overlapping it).
   void collect_vertices(const Aabb2& box, std::vector<VertexHandle>& out);
-  void touch(VertexHandle v);                  // joins L_e (idle count reset)
+  void touch(VertexHandle v) {  // joins L_e (idle count reset); inline: erosion's hottest call
+    VertexInfo& in = v->info();
+    in.idle = 0;
+    if (in.erosion_slot != kNoSlot) return;
+    in.erosion_slot = static_cast<std::uint32_t>(erosion_list_.size());
+    erosion_list_.push_back(ErosionEntry{v});
+  }
   void touch_with_neighbours(VertexHandle v);  // v and its neighbours join L_e
   // The finite neighbours of v, a vertex of L_e, counter-clockwise from v->face() (the order
   // of CGAL's vertex circulator): cached in ring_pool_ until v's star changes. O(1) amortized
