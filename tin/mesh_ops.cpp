@@ -435,14 +435,8 @@ void TinTerrain::collect_vertices(const Aabb2& box, std::vector<VertexHandle>& o
   }
 }
 
-void TinTerrain::touch_with_neighbours(VertexHandle v) {
-  touch(v);
-  for (VertexHandle w : ring_of(v)) touch(w);
-}
-
-std::span<const VertexHandle> TinTerrain::ring_of(VertexHandle v) {
+std::span<const VertexHandle> TinTerrain::fill_ring(VertexHandle v) {
   ErosionEntry* e = &erosion_list_[v->info().erosion_slot];
-  if (e->ring_size > 0) return {ring_pool_.data() + e->ring, e->ring_size};
   // The vertex circulator's walk, unrolled: the same start and counter-clockwise order.
   std::vector<VertexHandle>& ring = ring_scratch_;
   ring.clear();

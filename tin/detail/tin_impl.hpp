@@ -198,11 +198,19 @@ class TinTerrain final : public Terrain {
     in.erosion_slot = static_cast<std::uint32_t>(erosion_list_.size());
     erosion_list_.push_back(ErosionEntry{v});
   }
-  void touch_with_neighbours(VertexHandle v);  // v and its neighbours join L_e
+  void touch_with_neighbours(VertexHandle v) {  // v and its neighbours join L_e
+    touch(v);
+    for (VertexHandle w : ring_of(v)) touch(w);
+  }
   // The finite neighbours of v, a vertex of L_e, counter-clockwise from v->face() (the order
   // of CGAL's vertex circulator): cached in ring_pool_ until v's star changes. O(1) amortized
   // when current, O(degree) to refill; the span lasts until the pool grows.
-  std::span<const VertexHandle> ring_of(VertexHandle v);
+  std::span<const VertexHandle> ring_of(VertexHandle v) {
+    const ErosionEntry& e = erosion_list_[v->info().erosion_slot];
+    if (e.ring_size > 0) return {ring_pool_.data() + e.ring, e.ring_size};
+    return fill_ring(v);
+  }
+  std::span<const VertexHandle> fill_ring(VertexHandle v);  // ring_of when not current
   // The live rings moved to a new pool of this capacity (at least what they need), the
   // garbage left behind. O(L_e + live rings).
   void compact_ring_pool(std::size_t capacity);
