@@ -44,6 +44,8 @@ VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* insert
 }
 
 std::size_t TinTerrain::refine_around(VertexHandle v) {
+  // has_long_edges' cached answer, read here: erosion asks for every transfer.
+  if (v->info().short_edges) return 0;
   std::size_t splits = 0;
   for (int guard = 0; guard < 64 && has_long_edges(v); ++guard) {
     // The longest edge that can be split: a constrained edge only where its middle is
