@@ -76,6 +76,51 @@ std::size_t TinTerrain::refine_around(VertexHandle v) {
   return splits;
 }
 
+bool TinTerrain::refine_crease(VertexHandle v) {
+  // Only edges that sand crosses now (transfer_scratch_ > 0): measured on pile.toml, also
+  // splitting creases nothing flows across adds vertices without making the pile rounder.
+  // Facet k is (v, ring[k], ring[k + 1]) (the ring is counter-clockwise); edge (v, ring[k])
+  // lies between facets k - 1 and k. A pair spanning 180 degrees or more (a border vertex's
+  // gap) forms no facet, and its edges are not creases.
+  const std::size_t n = nbr_scratch_.size();
+  if (n < 3) return false;
+  const double z = v->point().z();
+  const auto facet_gradient = [&](std::size_t k, Vec2& g) {
+    const ErosionNeighbour& a = nbr_scratch_[k];
+    const ErosionNeighbour& b = nbr_scratch_[(k + 1) % n];
+    const double cross = a.dx * b.dy - a.dy * b.dx;
+    if (!(cross > 1e-9 * a.distance * b.distance)) return false;
+    const double ha = a.z - z, hb = b.z - z;
+    g = Vec2((ha * b.dy - hb * a.dy) / cross, (hb * a.dx - ha * b.dx) / cross);
+    return true;
+  };
+  std::size_t best = n;
+  double longest = fine_m_;
+  Vec2 before(0.0, 0.0);
+  bool has_before = facet_gradient(n - 1, before);
+  for (std::size_t k = 0; k < n; ++k) {
+    Vec2 after(0.0, 0.0);
+    const bool has_after = facet_gradient(k, after);
+    const double d = nbr_scratch_[k].distance;
+    if (transfer_scratch_[k] > 0.0 && has_before && has_after && d > longest &&
+        0.25 * d * (after - before).norm() > curvature_tolerance_m_) {
+      best = k;
+      longest = d;
+    }
+    before = after;
+    has_before = has_after;
+  }
+  if (best == n) return false;
+  // A constrained edge only where its middle is exactly on it (as in refine_around).
+  const VertexHandle w = vertex_scratch_[best];
+  FaceHandle f;
+  int i = 0;
+  if (cdt_.is_edge(v, w, f, i) && f->is_constrained(i) && locate(0.5 * (xy(w) + xy(v))).type != Cdt::EDGE) return false;
+  bool inserted = false;
+  split_edge(v, w, &inserted);
+  return inserted;
+}
+
 ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& budget) {
   // The fan gradient is too coarse an estimate to cap drops by (common/erosion.hpp).
   ErosionRule rule = given;
@@ -107,6 +152,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
         std::size_t splits = refine_around(v);
         for (std::size_t k = 0; k < nbr_scratch_.size(); ++k)
           if (transfer_scratch_[k] > 0.0) splits += refine_around(vertex_scratch_[k]);
+        if (splits == 0 && fine_m_ < refine_m_ && refine_crease(v)) splits = 1;
         if (splits == 0) break;
         area = gather_neighbours(v);
         transfer_scratch_.resize(nbr_scratch_.size());
