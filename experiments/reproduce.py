@@ -27,6 +27,7 @@ import exp_fig8_9
 import exp_haptics
 import exp_memory
 import exp_orientation
+import exp_settling
 import exp_sparse
 import exp_stability
 
@@ -40,6 +41,7 @@ EXPERIMENTS = {
     "alpha_flat": exp_alpha_flat,
     "accuracy": exp_accuracy,
     "orientation": exp_orientation,
+    "settling": exp_settling,
     "stability": exp_stability,
     "haptics": exp_haptics,
 }

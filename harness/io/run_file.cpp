@@ -2,11 +2,13 @@
 
 #include <hdf5.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <optional>
@@ -106,6 +108,8 @@ Handle create_dataset(hid_t parent, const std::string& name, hid_t mem_type, con
     std::vector<hsize_t> chunk = dims;
     chunk[0] = std::min<hsize_t>(dims[0], std::max<hsize_t>(1, 65536 / std::max<hsize_t>(1, count / dims[0])));
     check(H5Pset_chunk(plist, static_cast<int>(chunk.size()), chunk.data()), "chunk " + name);
+    // Byte shuffling first: the coordinates' high bytes repeat, and deflate then finds them.
+    check(H5Pset_shuffle(plist), "shuffle " + name);
     check(H5Pset_deflate(plist, 4), "compress " + name);
   }
   return Handle(
@@ -272,6 +276,46 @@ void write_contents(hid_t file, const RunResult& run, const PreparedScene& p, co
   run.stream_final_mesh(writer);
 }
 
+// The in-memory file's buffer, allocated through HDF5's file image callbacks so that the
+// finished image is written to disk from where the core driver built it: no second copy of
+// a file that can be as large as the model (H5Fget_file_image would copy it).
+struct CoreImage {
+  void* data = nullptr;
+  std::size_t size = 0;
+};
+
+void* image_malloc(std::size_t size, H5FD_file_image_op_t, void* udata) {
+  auto* image = static_cast<CoreImage*>(udata);
+  image->data = std::malloc(size);
+  image->size = image->data ? size : 0;
+  return image->data;
+}
+
+void* image_realloc(void* ptr, std::size_t size, H5FD_file_image_op_t, void* udata) {
+  auto* image = static_cast<CoreImage*>(udata);
+  void* grown = std::realloc(ptr, size);
+  if (grown) {
+    image->data = grown;
+    image->size = size;
+  }
+  return grown;
+}
+
+herr_t image_free(void* ptr, H5FD_file_image_op_t, void* udata) {
+  auto* image = static_cast<CoreImage*>(udata);
+  if (ptr == image->data) *image = CoreImage{};
+  std::free(ptr);
+  return 0;
+}
+
+void* image_memcpy(void* dest, const void* src, std::size_t size, H5FD_file_image_op_t, void*) {
+  return std::memcpy(dest, src, size);
+}
+
+// The property list's copies share the one CoreImage, which outlives them.
+void* share_image(void* udata) { return udata; }
+herr_t keep_image(void*) { return 0; }
+
 // Reading.
 
 // A string attribute or scalar dataset, variable-length or (files before 2026-11) fixed-length.
@@ -378,23 +422,26 @@ void write_run_file(const std::filesystem::path& path, const RunResult& run, con
   // The file is assembled in memory (HDF5's core driver, no backing store) and then written
   // with plain I/O: a full disk is then our own write error. Were HDF5 writing to disk, a
   // failed flush would leave its file open, and HDF5's exit handler crashes on it.
-  std::vector<char> image;
-  {
-    Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "create file access properties");
-    check(H5Pset_fapl_core(fapl, std::size_t{1} << 20, /*backing_store=*/0), "use the in-memory driver");
-    const std::string name = path.string() + ".in-memory";  // never touched on disk
-    Handle file(H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl), H5Fclose, "create " + path.string());
-    write_contents(file, run, prepared, summary);
-    check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush " + path.string());
-    const ssize_t size = H5Fget_file_image(file, nullptr, 0);
-    if (size < 0) throw std::runtime_error("HDF5: cannot size the file image of " + path.string());
-    image.resize(static_cast<std::size_t>(size));
-    if (H5Fget_file_image(file, image.data(), image.size()) != size)
-      throw std::runtime_error("HDF5: cannot copy the file image of " + path.string());
-  }
+  CoreImage image;
+  Handle fapl(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "create file access properties");
+  check(H5Pset_fapl_core(fapl, std::size_t{1} << 20, /*backing_store=*/0), "use the in-memory driver");
+  H5FD_file_image_callbacks_t callbacks{image_malloc, image_memcpy, image_realloc, image_free,
+                                        share_image,  keep_image,   &image};
+  check(H5Pset_file_image_callbacks(fapl, &callbacks), "set the in-memory file's allocator");
+  const std::string name = path.string() + ".in-memory";  // never touched on disk
+  Handle file(H5Fcreate(name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl), H5Fclose, "create " + path.string());
+  write_contents(file, run, prepared, summary);
+  check(H5Fflush(file, H5F_SCOPE_GLOBAL), "flush " + path.string());
+  // The file's length (its end of allocation); the buffer may be shorter when the last bytes
+  // were allocated but never written: the core driver reads those as zeros, and so do we.
+  const ssize_t size = H5Fget_file_image(file, nullptr, 0);
+  if (size < 0) throw std::runtime_error("HDF5: cannot size the file image of " + path.string());
+  const std::size_t length = static_cast<std::size_t>(size), stored = std::min(length, image.size);
   write_atomically(path, [&](const std::filesystem::path& tmp) {
     std::FILE* f = std::fopen(tmp.c_str(), "wb");
-    bool ok = f && std::fwrite(image.data(), 1, image.size(), f) == image.size() && std::fflush(f) == 0;
+    bool ok = f && std::fwrite(image.data, 1, stored, f) == stored;
+    for (std::size_t i = stored; ok && i < length; ++i) ok = std::fputc(0, f) != EOF;
+    ok = ok && std::fflush(f) == 0;
     const int error = errno;
     if (f && std::fclose(f) != 0) ok = false;
     // Disk full, quota, read-only: the user's to fix (exit 2); write_atomically removes tmp.
