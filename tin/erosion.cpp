@@ -94,21 +94,18 @@ bool TinTerrain::refine_crease(VertexHandle v) {
     g = Vec2((ha * b.dy - hb * a.dy) / cross, (hb * a.dx - ha * b.dx) / cross);
     return true;
   };
+  // Only the edges sand crosses, longer than the best so far, need their two facets.
   std::size_t best = n;
   double longest = fine_m_;
-  Vec2 before(0.0, 0.0);
-  bool has_before = facet_gradient(n - 1, before);
   for (std::size_t k = 0; k < n; ++k) {
-    Vec2 after(0.0, 0.0);
-    const bool has_after = facet_gradient(k, after);
     const double d = nbr_scratch_[k].distance;
-    if (transfer_scratch_[k] > 0.0 && has_before && has_after && d > longest &&
-        0.25 * d * (after - before).norm() > curvature_tolerance_m_) {
+    if (!(transfer_scratch_[k] > 0.0) || d <= longest) continue;
+    Vec2 before(0.0, 0.0), after(0.0, 0.0);
+    if (!facet_gradient((k + n - 1) % n, before) || !facet_gradient(k, after)) continue;
+    if (0.25 * d * (after - before).norm() > curvature_tolerance_m_) {
       best = k;
       longest = d;
     }
-    before = after;
-    has_before = has_after;
   }
   if (best == n) return false;
   // A constrained edge only where its middle is exactly on it (as in refine_around).
