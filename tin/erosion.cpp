@@ -86,12 +86,9 @@ bool TinTerrain::refine_crease(VertexHandle v) {
   if (n < 3) return false;
   const double z = v->point().z();
   const auto facet_gradient = [&](std::size_t k, Vec2& g) {
-    const ErosionNeighbour& a = nbr_scratch_[k];
-    const ErosionNeighbour& b = nbr_scratch_[(k + 1) % n];
-    const double cross = a.dx * b.dy - a.dy * b.dx;
-    if (!(cross > 1e-9 * a.distance * b.distance)) return false;
-    const double ha = a.z - z, hb = b.z - z;
-    g = Vec2((ha * b.dy - hb * a.dy) / cross, (hb * a.dx - ha * b.dx) / cross);
+    double gx = 0.0, gy = 0.0, cross = 0.0;
+    if (!facet_moment(z, nbr_scratch_[k], nbr_scratch_[(k + 1) % n], gx, gy, cross)) return false;
+    g = Vec2(gx / cross, gy / cross);
     return true;
   };
   // Only the edges sand crosses, longer than the best so far, need their two facets.
