@@ -35,7 +35,7 @@ ErosionReport GridTerrain<Real>::erode(const ErosionRule& rule, const ErosionBud
   const bool gradient = rule.needs_gradient();
   if (!tables_ || !tables_->built_for(rule, gradient)) tables_.emplace(grid_.layout(), stencil_.size, rule, gradient);
   const double carry_before = grid_.carry_m3();
-  ErosionReport report = erode_ordered(grid_, active_, *tables_, budget, sweep_path_);
+  ErosionReport report = erode_settling(grid_, active_, *tables_, budget, sweep_path_, multires_);
   // Transfers conserve volume; only rounding into the carry changes the stored volume.
   report.volume_change_m3 = carry_before - grid_.carry_m3();
   return report;

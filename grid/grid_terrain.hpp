@@ -33,7 +33,9 @@
 //                               pass O(nodes between the first and last member of each
 //                               row), the stable ones classed with vector arithmetic;
 //                               never the whole grid unless every row is active
-//                               (erosion_kernel.hpp: node-class tables, built once per rule)
+//                               (erosion_kernel.hpp: node-class tables, built once per rule);
+//                               settling budgets add the cascade's O(box around the active
+//                               set) per call (multires_settle.hpp)
 //   simplify                    O(1), nothing to simplify on a grid (reports a zero change)
 //   volume, max_slope_deg,
 //   mesh, check                 O(n)
@@ -55,13 +57,21 @@
 // On these states most visited nodes transfer, and a transferring visit costs ~180
 // instructions (8 neighbours); the vector classing only saves the visits of stable nodes.
 // A stamp ~80 ns per node of its window, e.g. 3 ms for a 64-cell (32 cm) disk.
-// Settling (relax_at_end) is diffusive near the critical angle: on flat_stroke.toml the
-// passes to settle grow 3.4-3.8x per halving of the cell (163, 552, 2077 at 2.5, 1.25,
+// Settling (relax_at_end) alone is diffusive near the critical angle: on flat_stroke.toml
+// the passes to settle grow 3.4-3.8x per halving of the cell (163, 552, 2077 at 2.5, 1.25,
 // 0.625 mm); neither a larger transfer fraction (1.9: 49, 157, 537 passes) nor the ordered
-// or dense sweeps change that exponent, they only make each pass cheaper. Stroke and
-// settling of flat_stroke.toml at 0.32, 1.3 and 5.1 M nodes (one interleaved run with main,
-// loaded VM): edge rule 0.070, 0.98, 14.8 s (main 0.127, 1.92, 27.4 s), gradient rule 0.142,
-// 3.08, 44.9 s (main 0.175, 2.79, 63.6 s): time grows as n^1.9 (edge) to n^2.1 (gradient).
+// or dense sweeps change that exponent, they only make each pass cheaper. Settling budgets
+// (32 passes or more, 1024 active nodes or more) therefore start with a coarse-to-fine
+// cascade (multires_settle.hpp) that moves the sand over long distances on coarse copies of
+// the grid before the fine passes finish: O(box around the active set) per call, plus the
+// coarse levels' visits. Stroke and settling of flat_stroke.toml at 0.32, 1.3 and 5.1 M
+// nodes, medians of 3 runs interleaved with main (loaded 2-vCPU VM): gradient rule 0.094,
+// 0.44, 2.0 s (main 0.29, 4.2, 53.6 s), edge rule 0.048, 0.21, 1.02 s (main 0.097, 1.32,
+// 19.8 s): time grows as n^1.11 for both rules (main n^1.9). Settling's updates at 5.1 M
+// nodes: 21.7 M in 10 calls of 64 passes (main: 727 M in 254), edge rule 18.2 M in 7 (main:
+// 503 M in 127). Volume drift 0; trench walls (trench_azimuth.toml, 9 azimuths, 8
+// neighbours, gradient rule) 30.075 degrees on average, every section within 0.16 of 30
+// (fine passes alone: 30.080, 0.16).
 // See README, "The three back-ends at a glance".
 #include <functional>
 #include <memory>
@@ -73,6 +83,7 @@
 #include "grid/active_set.hpp"
 #include "grid/erosion_kernel.hpp"
 #include "grid/height_grid.hpp"
+#include "grid/multires_settle.hpp"
 #include "grid/stencil.hpp"
 
 namespace sb::grid {
@@ -102,6 +113,9 @@ class GridTerrain final : public Terrain {
   // runs (default Auto: the dense pass when the members fill an eighth of their row spans).
   void activate_all() { active_.activate_all(); }
   void set_sweep_path(SweepPath path) { sweep_path_ = path; }
+  // Whether large settling budgets start with the multi-resolution cascade (default on;
+  // multires_settle.hpp).
+  void set_multires(bool on) { multires_ = on; }
   const GridLayout& layout() const { return grid_.layout(); }
   const HeightGrid<Real>& heights() const { return grid_; }
   const ActiveSet& active_set() const { return active_; }
@@ -112,6 +126,7 @@ class GridTerrain final : public Terrain {
   Stencil stencil_;
   ActiveSet active_;
   SweepPath sweep_path_ = SweepPath::Auto;
+  bool multires_ = true;
   std::optional<ErosionTables> tables_;  // built on the first erode, rebuilt when the rule changes
 };
 

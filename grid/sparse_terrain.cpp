@@ -36,7 +36,7 @@ ErosionReport SparseGridTerrain<Real>::erode(const ErosionRule& rule, const Eros
   if (!tables_ || !tables_->built_for(rule, gradient))
     tables_.emplace(heights_.layout(), stencil_.size, rule, gradient);
   const double carry_before = heights_.carry_m3();
-  ErosionReport report = erode_ordered(heights_, active_, *tables_, budget, sweep_path_);
+  ErosionReport report = erode_settling(heights_, active_, *tables_, budget, sweep_path_, multires_);
   // Transfers conserve volume; only rounding into the carry changes the stored volume.
   report.volume_change_m3 = carry_before - heights_.carry_m3();
   // Settled: blocks that came back to one height become tiles again.

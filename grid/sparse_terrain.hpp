@@ -38,6 +38,7 @@
 #include "common/scene.hpp"
 #include "common/terrain.hpp"
 #include "grid/erosion_kernel.hpp"
+#include "grid/multires_settle.hpp"
 #include "grid/sparse_heights.hpp"
 #include "grid/sparse_idle_counts.hpp"
 #include "grid/stencil.hpp"
@@ -68,6 +69,9 @@ class SparseGridTerrain final : public Terrain {
   // runs (default Auto: the dense pass when the members fill an eighth of their row spans).
   void activate_all() { active_.activate_all(); }
   void set_sweep_path(SweepPath path) { sweep_path_ = path; }
+  // Whether large settling budgets start with the multi-resolution cascade (default on;
+  // multires_settle.hpp).
+  void set_multires(bool on) { multires_ = on; }
   const GridLayout& layout() const { return heights_.layout(); }
   const SparseHeights<Real>& heights() const { return heights_; }
   const SparseActiveSet& active_set() const { return active_; }
@@ -77,6 +81,7 @@ class SparseGridTerrain final : public Terrain {
   Stencil stencil_;
   SparseActiveSet active_;
   SweepPath sweep_path_ = SweepPath::Auto;
+  bool multires_ = true;
   std::optional<ErosionTables> tables_;  // built on the first erode, rebuilt when the rule changes
 };
 

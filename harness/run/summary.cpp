@@ -10,7 +10,7 @@ namespace sb {
 Json summarize(const RunResult& run, const PreparedScene& p) {
   double tool = 0, erosion = 0, simplify = 0, detect = 0, remove = 0, relax = 0;
   double d_tool = 0, d_erosion = 0, d_simplify = 0;
-  std::uint64_t touched = 0, updates = 0, removed = 0;
+  std::uint64_t touched = 0, updates = 0, relax_updates = 0, removed = 0;
   std::vector<double> step_ms;
   std::size_t stamps = 0, relax_steps = 0;
   for (const StepRecord& r : run.steps) {
@@ -20,6 +20,7 @@ Json summarize(const RunResult& run, const PreparedScene& p) {
     removed += r.removed;
     if (r.stamp < 0) {
       relax += r.total_s();
+      relax_updates += r.erosion_updates;
       ++relax_steps;
       continue;
     }
@@ -67,6 +68,7 @@ Json summarize(const RunResult& run, const PreparedScene& p) {
   j["time_s.remove"] = remove;
   j["time_s.relax"] = relax;
   j["relax_steps"] = relax_steps;
+  j["relax_updates"] = relax_updates;
   j["volume_tracking_error"] = run.volume_tracking_error;
   j["volume_delta_tool"] = d_tool;
   j["volume_delta_erosion"] = d_erosion;

@@ -17,6 +17,7 @@
 
 #include "grid/grid_terrain.hpp"
 #include "grid/sparse_terrain.hpp"
+#include "grid_rough_states.hpp"
 
 namespace sb::grid {
 namespace {
@@ -26,31 +27,10 @@ namespace {
 constexpr double kCell = 0.005;
 const GridLayout kLayout = GridLayout::covering({{0.0, 0.0}, {0.3, 0.23}}, kCell);
 
-double rough(const Vec2& p, std::uint64_t seed) {
-  std::uint64_t h = seed * 0x9E3779B97F4A7C15ull ^
-                    static_cast<std::uint64_t>(std::llround(p.x() * 1e4)) * 0xBF58476D1CE4E5B9ull ^
-                    static_cast<std::uint64_t>(std::llround(p.y() * 1e4)) * 0x94D049BB133111EBull;
-  h ^= h >> 31;
-  h *= 0xD6E8FEB86639EB69ull;
-  h ^= h >> 29;
-  const double u = static_cast<double>(h >> 11) / 9007199254740992.0;  // [0, 1)
-  return 0.1 + (u - 0.5) * 3.0 * kCell;
-}
-
-struct Case {
-  ErosionRuleKind rule;
-  int neighbours;
-  bool is_float;
-};
-
-std::string name(const Case& c) {
-  return std::string(to_string(c.rule)) + "_" + std::to_string(c.neighbours) + (c.is_float ? "_float" : "_double");
-}
-
-ErosionRule rule_for(ErosionRuleKind kind) {
-  Material m;  // 30 degrees, fraction 0.5
-  return ErosionRule::from(m, 0.1, kind);
-}
+double rough(const Vec2& p, std::uint64_t seed) { return test::rough_height(p, seed, kCell); }
+using Case = test::ErosionCase;
+using test::name;
+using test::rule_for;
 
 template <class T>
 std::vector<double> heights_of(const T& t) {
@@ -145,13 +125,7 @@ TEST_P(DensePass, ConservesAndSettlesCloseToTheActiveSetPath) {
     paths_agree<double>();
 }
 
-INSTANTIATE_TEST_SUITE_P(RulesStencilsStorage, DensePass,
-                         ::testing::Values(Case{ErosionRuleKind::Edge, 8, false}, Case{ErosionRuleKind::Edge, 4, false},
-                                           Case{ErosionRuleKind::Gradient, 8, false},
-                                           Case{ErosionRuleKind::Gradient, 4, false},
-                                           Case{ErosionRuleKind::Edge, 8, true},
-                                           Case{ErosionRuleKind::Gradient, 8, true},
-                                           Case{ErosionRuleKind::Gradient, 4, true}),
+INSTANTIATE_TEST_SUITE_P(RulesStencilsStorage, DensePass, test::erosion_cases(),
                          [](const ::testing::TestParamInfo<Case>& info) { return name(info.param); });
 
 // The dense pass keeps the active set word by word: the same members as activate_block per
