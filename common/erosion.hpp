@@ -87,23 +87,33 @@ struct SurfaceGradient {
   double x = 0.0, y = 0.0;
 };
 
+// Facet (centre, j, k), neighbours counter-clockwise: twice its area (`cross`) and twice its
+// area times its gradient (`gx`, `gy`); false (outputs unset) when the pair spans 180 degrees
+// or more and forms no facet. The gradient is (gx, gy) / cross. O(1).
+inline bool facet_moment(double z_i, const ErosionNeighbour& j, const ErosionNeighbour& k, double& gx, double& gy,
+                         double& cross) {
+  // area * gradient = ((z_j - z_i) perp(e_k) - (z_k - z_i) perp(e_j)) / 2, perp(x, y) = (y, -x).
+  cross = j.dx * k.dy - j.dy * k.dx;
+  if (!(cross > 1e-9 * j.distance * k.distance)) return false;
+  const double hj = j.z - z_i, hk = k.z - z_i;
+  gx = hj * k.dy - hk * j.dy;
+  gy = hk * j.dx - hj * k.dx;
+  return true;
+}
+
 // Area-weighted mean of the facet gradients of the fan the centre forms with consecutive
 // neighbours of `ring` (counter-clockwise around the centre, last to first included). Pairs
 // that span 180 degrees or more (the gap at a border vertex) form no facet and are skipped;
 // zero when none does. Exact for a plane. O(ring size).
 inline SurfaceGradient fan_gradient(double z_i, std::span<const ErosionNeighbour> ring) {
-  // For a facet (i, j, k): area * gradient = ((z_j - z_i) perp(e_k) - (z_k - z_i) perp(e_j)) / 2,
-  // perp(x, y) = (y, -x); no division per facet.
+  // No division per facet (facet_moment).
   double sx = 0.0, sy = 0.0, area2 = 0.0;
   const std::size_t n = ring.size();
   for (std::size_t a = 0; a < n && n >= 2; ++a) {
-    const ErosionNeighbour& j = ring[a];
-    const ErosionNeighbour& k = ring[a + 1 < n ? a + 1 : 0];  // (no division in the hot loop)
-    const double cross = j.dx * k.dy - j.dy * k.dx;
-    if (!(cross > 1e-9 * j.distance * k.distance)) continue;
-    const double hj = j.z - z_i, hk = k.z - z_i;
-    sx += hj * k.dy - hk * j.dy;
-    sy += hk * j.dx - hj * k.dx;
+    double gx = 0.0, gy = 0.0, cross = 0.0;
+    if (!facet_moment(z_i, ring[a], ring[a + 1 < n ? a + 1 : 0], gx, gy, cross)) continue;  // (no modulo)
+    sx += gx;
+    sy += gy;
     area2 += cross;
   }
   if (area2 <= 0.0) return {};

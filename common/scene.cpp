@@ -429,6 +429,8 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   s.tin.initial_jitter = f.number("tin.initial_jitter", 0.5, closed(0.0, 0.9));
   s.tin.contour_gap_m = f.number("tin.contour_gap_m", 0.0, closed(0.0, extent));
   s.tin.refine_m = f.number("tin.refine_m", 0.0, closed(0.0, extent));
+  s.tin.curvature_tolerance_m = f.number("tin.curvature_tolerance_m", 0.0, closed(0.0, 1e6));
+  s.tin.refine_min_m = f.number("tin.refine_min_m", 0.0, closed(0.0, extent));
   s.tin.planar_tolerance_m = f.number("tin.planar_tolerance_m", 0.0, closed(0.0, 1e6));
   s.tin.coarsen = f.boolean("tin.coarsen", false);
 

@@ -65,6 +65,11 @@ struct TinSpec {
   double contour_gap_m = 0.0;   // outer-to-inner contour distance; 0: 5% of the tool size
   double refine_m = 0.0;        // erosion splits edges longer than this that sand flows
                                 // across; 0: 4 tolerance_m / tan(critical angle)
+  // Where sand flows across an edge between two facets whose gradients differ by dg, linear
+  // interpolation along that crease errs by about length * dg / 4: erosion also splits edges
+  // whose error exceeds curvature_tolerance_m, down to refine_min_m (0: refine_m / 2; at least refine_m / 4). 0: off.
+  double curvature_tolerance_m = 0.0;
+  double refine_min_m = 0.0;
   // coarsen: simplification also removes settled vertices within planar_tolerance_m of the
   // plane fitted to their neighbours (volume-preserving; 0: tolerance_m / 4). Off by default:
   // with the edge-wise erosion rule the coarser mesh settles with triangles up to a few

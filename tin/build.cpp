@@ -57,7 +57,14 @@ TinTerrain::TinTerrain(const Scene& scene)
   refine_m_ = spec_.refine_m > 0.0 ? spec_.refine_m : default_refine_m(scene);
   // Never split below what snapping could merge again, nor below a ten-thousandth of the
   // domain (a 0.4 mm tool must not refine a 30 cm domain to 0.1 mm).
-  refine_m_ = std::max(refine_m_, std::max(64.0 * spec_.snap_m, 1e-4 * extent));
+  const double floor_m = std::max(64.0 * spec_.snap_m, 1e-4 * extent);
+  refine_m_ = std::max(refine_m_, floor_m);
+  // Curvature refinement goes down to refine_min_m (half of refine_m_ by default), never
+  // below a quarter of refine_m_: a tiny tolerance or refine_min_m cannot make the mesh
+  // explode (a 30 um floor on pile.toml ran 4 pours for over 5 minutes).
+  curvature_tolerance_m_ = spec_.curvature_tolerance_m;
+  const double fine = spec_.refine_min_m > 0.0 ? spec_.refine_min_m : 0.5 * refine_m_;
+  fine_m_ = curvature_tolerance_m_ > 0.0 ? std::clamp(fine, 0.25 * refine_m_, refine_m_) : refine_m_;
   // A thousandth of the TIN's accuracy: what coarsening may add to an edge's height drop.
   settle_dz_ = 1e-3 * spec_.tolerance_m;
   tan_critical_ = scene.material.tan_critical();

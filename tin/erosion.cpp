@@ -72,6 +72,45 @@ std::size_t TinTerrain::refine_around(VertexHandle v) {
   return splits;
 }
 
+bool TinTerrain::refine_crease(VertexHandle v) {
+  // Only edges that sand crosses now (transfer_scratch_ > 0): measured on pile.toml, also
+  // splitting creases nothing flows across adds vertices without making the pile rounder.
+  // Facet k is (v, ring[k], ring[k + 1]) (the ring is counter-clockwise); edge (v, ring[k])
+  // lies between facets k - 1 and k. A pair spanning 180 degrees or more (a border vertex's
+  // gap) forms no facet, and its edges are not creases.
+  const std::size_t n = nbr_scratch_.size();
+  if (n < 3) return false;
+  const double z = v->point().z();
+  const auto facet_gradient = [&](std::size_t k, Vec2& g) {
+    double gx = 0.0, gy = 0.0, cross = 0.0;
+    if (!facet_moment(z, nbr_scratch_[k], nbr_scratch_[(k + 1) % n], gx, gy, cross)) return false;
+    g = Vec2(gx / cross, gy / cross);
+    return true;
+  };
+  // Only the edges sand crosses, longer than the best so far, need their two facets.
+  std::size_t best = n;
+  double longest = fine_m_;
+  for (std::size_t k = 0; k < n; ++k) {
+    const double d = nbr_scratch_[k].distance;
+    if (!(transfer_scratch_[k] > 0.0) || d <= longest) continue;
+    Vec2 before(0.0, 0.0), after(0.0, 0.0);
+    if (!facet_gradient((k + n - 1) % n, before) || !facet_gradient(k, after)) continue;
+    if (0.25 * d * (after - before).norm() > curvature_tolerance_m_) {
+      best = k;
+      longest = d;
+    }
+  }
+  if (best == n) return false;
+  // A constrained edge only where its middle is exactly on it (as in refine_around).
+  const VertexHandle w = vertex_scratch_[best];
+  FaceHandle f;
+  int i = 0;
+  if (cdt_.is_edge(v, w, f, i) && f->is_constrained(i) && locate(0.5 * (xy(w) + xy(v))).type != Cdt::EDGE) return false;
+  bool inserted = false;
+  split_edge(v, w, &inserted);
+  return inserted;
+}
+
 ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& budget) {
   // The fan gradient is too coarse an estimate to cap drops by (common/erosion.hpp).
   ErosionRule rule = given;
@@ -104,6 +143,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
         std::size_t splits = refine_around(v);
         for (std::size_t k = 0; k < nbr_scratch_.size(); ++k)
           if (transfer_scratch_[k] > 0.0) splits += refine_around(vertex_scratch_[k]);
+        if (splits == 0 && fine_m_ < refine_m_ && refine_crease(v)) splits = 1;
         if (splits == 0) break;
         area = gather_neighbours(v);
         transfer_scratch_.resize(nbr_scratch_.size());

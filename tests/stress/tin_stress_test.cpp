@@ -1,7 +1,7 @@
 // Stress tests of the TIN: the inputs that trip CGAL's constrained triangulation when
 // constraints touch or cross (CGAL issues 2999, 3263, 5439) -- crossing strokes, a thousand
 // stamps at one spot, collinear and near-duplicate contours, random strokes -- with check()
-// after every step. About 30 s in Release.
+// after every step, and the same with curvature refinement. About 30 s in Release.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -120,6 +120,28 @@ TEST(TinStress, CrossingStrokes) {
                   text == kScene ? "flat" : "dunes", conserve, (run.terrain->volume() - v0) / v0,
                   run.terrain->stats().vertices);
     }
+  }
+}
+
+// Curvature refinement (tin.curvature_tolerance_m) splits constrained and unconstrained
+// creases between stamps: the mesh stays valid after every phase and the volume exact.
+TEST(TinStress, CrossingStrokesWithCurvatureRefinement) {
+  for (const char* text : {kScene, kDunes}) {
+    Runner run(parse_scene(text, "stress", {"tin.conserve_volume=true", "tin.curvature_tolerance_m=0.0003"}));
+    Runner plain(parse_scene(text, "stress", {"tin.conserve_volume=true"}));
+    const double v0 = run.terrain->volume();
+    for (const std::vector<Vec2>& path :
+         {std::vector<Vec2>{{0.05, 0.05}, {0.25, 0.25}}, std::vector<Vec2>{{0.05, 0.25}, {0.25, 0.05}}}) {
+      Stroke stroke = run.scene.stroke;
+      stroke.path_m = path;
+      stroke.spacing_m = 0.008;
+      for (const ToolStamp& st : run.schedule(stroke).stamps) {
+        ASSERT_TRUE(run.step(st));
+        plain.step(st);
+      }
+    }
+    EXPECT_NEAR(run.terrain->volume(), v0, 1e-12 * v0);
+    EXPECT_GT(run.terrain->stats().vertices, plain.terrain->stats().vertices) << "it refined";
   }
 }
 

@@ -259,6 +259,12 @@ class TinTerrain final : public Terrain {
   double gather_neighbours(VertexHandle v);
   // Splits v's edges longer than refine_m_ until none is; returns the number of splits.
   std::size_t refine_around(VertexHandle v);
+  // Curvature refinement: splits v's longest edge longer than fine_m_ that sand crosses (a
+  // transfer in transfer_scratch_) and across which the gradients of its two facets jump by
+  // more than 4 curvature_tolerance_m_ / length (linear interpolation along such a crease
+  // errs by about length x jump / 4). Reads v's ring from gather_neighbours and the transfers
+  // erosion computed on it; returns whether it split. O(ring).
+  bool refine_crease(VertexHandle v);
   // simplify.cpp: whether a triangle of the retriangulated hole (all its vertices in `link`)
   // is steeper than the stable slope.
   bool hole_is_steep(const std::vector<VertexHandle>& link) const;
@@ -270,7 +276,11 @@ class TinTerrain final : public Terrain {
   Aabb2 box_;
   TinSpec spec_;
   int idle_passes_ = 2;
-  double refine_m_ = 0.0;      // edge length above which erosion splits an edge it flows across
+  double refine_m_ = 0.0;  // edge length above which erosion splits an edge it flows across
+  // Curvature refinement (tin.curvature_tolerance_m; 0: off): edges between fine_m_ and
+  // refine_m_ are split too where length x facet-gradient jump / 4 exceeds the tolerance.
+  double fine_m_ = 0.0;
+  double curvature_tolerance_m_ = 0.0;
   double tool_size_m_ = 0.0;   // characteristic radius of the scene's tool
   double settle_dz_ = 0.0;     // coarsening: removals may not make an edge steeper by this much
   double tan_critical_ = 0.0;  // the scene material's, for coarsening
