@@ -215,9 +215,12 @@ class TinTerrain final : public Terrain {
   double gather_neighbours(VertexHandle v);
   // Splits v's edges longer than refine_m_ until none is; returns the number of splits.
   std::size_t refine_around(VertexHandle v);
-  // simplify.cpp: whether a triangle of the retriangulated hole (all its vertices in `link`)
-  // is steeper than the stable slope.
-  bool hole_is_steep(const std::vector<VertexHandle>& link) const;
+  // simplify.cpp: whether a triangle incident to a vertex of `link` (the retriangulated hole
+  // and the ring around it) is steeper than the stable slope. O(|link| * degree).
+  bool star_is_steep(const std::vector<VertexHandle>& link) const;
+  // simplify.cpp: one detection (over L_r, or every vertex with scan_all) and removal;
+  // `coarsen` allows the planar rule.
+  void simplify_round(double tan_alpha, bool coarsen, bool scan_all, SimplifyReport& report);
   // build.cpp
   void insert_corners(const std::function<double(const Vec2&)>& z);
   void finish_build();
@@ -226,11 +229,12 @@ class TinTerrain final : public Terrain {
   Aabb2 box_;
   TinSpec spec_;
   int idle_passes_ = 2;
-  double refine_m_ = 0.0;      // edge length above which erosion splits an edge it flows across
-  double tool_size_m_ = 0.0;   // characteristic radius of the scene's tool
-  double settle_dz_ = 0.0;     // coarsening: removals may not make an edge steeper by this much
-  double tan_critical_ = 0.0;  // the scene material's, for coarsening
-  double tan_settle_ = 0.0;    // and the steepest stable slope (erosion.settle_tolerance_deg)
+  double refine_m_ = 0.0;          // edge length above which erosion splits an edge it flows across
+  double tool_size_m_ = 0.0;       // characteristic radius of the scene's tool
+  double settle_dz_ = 0.0;         // coarsening: removals may not make an edge steeper by this much
+  double tan_critical_ = 0.0;      // the scene material's, for coarsening
+  double tan_settle_ = 0.0;        // and the steepest stable slope (erosion.settle_tolerance_deg)
+  bool rest_scan_pending_ = true;  // coarsening: scan every vertex at the next rest
   TerrainKind kind_ = TerrainKind::Flat;
   double base_height_m_ = 0.0;
 
@@ -256,6 +260,7 @@ class TinTerrain final : public Terrain {
   std::vector<VertexHandle> work_scratch_;       // erosion: the pass's copy of L_e
   std::vector<VertexHandle> redundant_scratch_;  // simplify: vertices to remove
   std::vector<VertexHandle> link_hold_scratch_;  // simplify: the removed vertex's link
+  std::vector<double> link_z_scratch_;           // simplify: the link's heights before the give-back
 };
 
 // Area of a finite face projected on the xy plane (positive: faces are counter-clockwise).
