@@ -215,9 +215,10 @@ class TinTerrain final : public Terrain {
   double gather_neighbours(VertexHandle v);
   // Splits v's edges longer than refine_m_ until none is; returns the number of splits.
   std::size_t refine_around(VertexHandle v);
-  // simplify.cpp: whether a triangle incident to a vertex of `link` (the retriangulated hole
-  // and the ring around it) is steeper than the stable slope. O(|link| * degree).
-  bool star_is_steep(const std::vector<VertexHandle>& link) const;
+  // simplify.cpp: whether a triangle incident to a vertex of `link` (only those of the
+  // retriangulated hole with hole_only, else also the ring around it) is steeper than the
+  // stable slope. O(|link|^2 * degree).
+  bool has_steep_triangle(const std::vector<VertexHandle>& link, bool hole_only) const;
   // simplify.cpp: one detection (over L_r, or every vertex with scan_all) and removal;
   // `coarsen` allows the planar rule.
   void simplify_round(double tan_alpha, bool coarsen, bool scan_all, SimplifyReport& report);
