@@ -59,7 +59,7 @@ std::string scene_key_meaning(const std::string& key) {
        "erosion splits edges longer than this that sand flows across; 0: 4 tin.tolerance_m / tan(critical), "
        "at least half the tool radius, at most 5% of the domain"},
       {"tin.planar_tolerance_m", "height tolerance of the coarsening; 0: tin.tolerance_m / 4"},
-      {"tin.coarsen", "simplification also removes settled vertices near the plane of their neighbours"},
+      {"tin.coarsen", "at rest, simplification also removes vertices near the plane of their neighbours"},
       {"grid.cell_m", "node spacing"},
       {"grid.storage", "height storage type"},
       {"grid.neighbours", "erosion stencil (4 or 8)"},
