@@ -25,7 +25,8 @@
 //                     evenly spaced, same area), so tool.sides = 4096 costs what 16 sides do
 //   erode             O(|L_e| * degree) per pass (vertex areas are cached), about 0.25 us
 //                     per vertex visit; an edge split is O(1)
-//   simplify          detect O(|L_r| * degree); removal O(degree) per vertex
+//   simplify          detect O(|L_r| * degree); removal O(degree) per vertex; with
+//                     tin.coarsen, once per rest after activity: detect O(n * degree)
 //   one step          stamp + 4 erosion passes + simplify: 0.6 to 0.7 ms CPU at every n from
 //                     10^3 to 10^6, on tin.initial_points TINs with their border points too,
 //                     log-log slope -0.006 (tests/bench/tin_step_bench.cpp; 0.73 ms on the
