@@ -12,23 +12,17 @@
 namespace sb::tin::detail {
 
 double TinTerrain::gather_neighbours(VertexHandle v) {
-  vertex_scratch_.clear();
-  nbr_scratch_.clear();
   const Point& p = v->point();
-  // The vertex circulator's walk, unrolled (same start and counter-clockwise order): this is
-  // the hottest loop of a step.
-  const VertexHandle infinite = cdt_.infinite_vertex();
-  const FaceHandle start = v->face();
-  FaceHandle f = start;
-  do {
-    const int i = Cdt::ccw(f->index(v));
-    const VertexHandle w = f->vertex(i);
-    f = f->neighbor(i);
-    if (w == infinite) continue;
-    vertex_scratch_.push_back(w);
-    const double ex = w->point().x() - p.x(), ey = w->point().y() - p.y();
-    nbr_scratch_.push_back({w->point().z(), std::sqrt(ex * ex + ey * ey), cached_area(w), ex, ey});
-  } while (f != start);
+  // The hottest loop of a step: the ring comes from the cache (its walk is repeated only when
+  // v's star changed), heights and areas are read fresh.
+  const std::span<const VertexHandle> ring = ring_of(v);
+  vertex_scratch_.assign(ring.begin(), ring.end());
+  nbr_scratch_.resize(ring.size());
+  for (std::size_t k = 0; k < ring.size(); ++k) {
+    const Point& q = ring[k]->point();
+    const double ex = q.x() - p.x(), ey = q.y() - p.y();
+    nbr_scratch_[k] = {q.z(), std::sqrt(ex * ex + ey * ey), cached_area(ring[k]), ex, ey};
+  }
   return cached_area(v);
 }
 
@@ -50,6 +44,8 @@ VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* insert
 }
 
 std::size_t TinTerrain::refine_around(VertexHandle v) {
+  // has_long_edges' cached answer, read here: erosion asks for every transfer.
+  if (v->info().short_edges) return 0;
   std::size_t splits = 0;
   for (int guard = 0; guard < 64 && has_long_edges(v); ++guard) {
     // The longest edge that can be split: a constrained edge only where its middle is
@@ -93,7 +89,8 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
   for (int pass = 0; pass < budget.max_passes && !erosion_list_.empty() && report.updates < budget.max_updates;
        ++pass) {
     ++report.passes;
-    work.assign(erosion_list_.begin(), erosion_list_.end());
+    work.clear();
+    for (const ErosionEntry& e : erosion_list_) work.push_back(e.vertex);
     for (VertexHandle v : work) {
       if (report.updates >= budget.max_updates) break;
       if (v->info().erosion_slot == kNoSlot) continue;
@@ -141,6 +138,15 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
         drop_from_erosion(v);  // (coarsening scans every vertex once the terrain is at rest)
       }
     }
+  }
+  // A settling region leaves L_e, and its rings become garbage: give the memory back (all of
+  // it, with L_e's, once everything has settled).
+  if (erosion_list_.empty()) {
+    std::vector<ErosionEntry>().swap(erosion_list_);
+    std::vector<VertexHandle>().swap(ring_pool_);
+    ring_pool_live_ = 0;
+  } else if (ring_pool_.capacity() > 256 && 4 * ring_pool_live_ < ring_pool_.capacity()) {
+    compact_ring_pool(2 * ring_pool_live_);
   }
   report.active = erosion_list_.size();
   return report;

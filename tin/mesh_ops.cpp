@@ -209,10 +209,7 @@ void TinTerrain::remove_vertex(VertexHandle v) {
   } while (++c != done);
   cdt_.remove(v);
   // The hole is retriangulated from its boundary, the removed vertex's neighbours.
-  for (VertexHandle w : link_scratch_) {
-    w->info().area = -1.0;
-    w->info().short_edges = 0;
-  }
+  for (VertexHandle w : link_scratch_) forget_caches(w);
 }
 
 void TinTerrain::constrain(VertexHandle a, VertexHandle b, std::uint32_t generation) {
@@ -282,20 +279,11 @@ double TinTerrain::vertex_area(VertexHandle v) const {
   return area / 3.0;
 }
 
-double TinTerrain::cached_area(VertexHandle v) const {
-  VertexInfo& in = v->info();
-  if (in.area < 0.0) in.area = vertex_area(v);
-  return in.area;
-}
-
 void TinTerrain::forget_star(VertexHandle v) {
-  v->info().area = -1.0;
-  v->info().short_edges = 0;
+  forget_caches(v);
   auto c = cdt_.incident_vertices(v), done = c;
   do {
-    if (cdt_.is_infinite(c)) continue;
-    c->info().area = -1.0;
-    c->info().short_edges = 0;
+    if (!cdt_.is_infinite(c)) forget_caches(c);
   } while (++c != done);
 }
 
@@ -447,28 +435,71 @@ void TinTerrain::collect_vertices(const Aabb2& box, std::vector<VertexHandle>& o
   }
 }
 
-void TinTerrain::touch(VertexHandle v) {
-  VertexInfo& in = v->info();
-  in.idle = 0;
-  if (in.erosion_slot != kNoSlot) return;
-  in.erosion_slot = static_cast<std::uint32_t>(erosion_list_.size());
-  erosion_list_.push_back(v);
+std::span<const VertexHandle> TinTerrain::fill_ring(VertexHandle v) {
+  ErosionEntry* e = &erosion_list_[v->info().erosion_slot];
+  // The vertex circulator's walk, unrolled: the same start and counter-clockwise order.
+  std::vector<VertexHandle>& ring = ring_scratch_;
+  ring.clear();
+  const VertexHandle infinite = cdt_.infinite_vertex();
+  const FaceHandle start = v->face();
+  FaceHandle f = start;
+  do {
+    const int i = Cdt::ccw(f->index(v));
+    const VertexHandle w = f->vertex(i);
+    f = f->neighbor(i);
+    if (w != infinite) ring.push_back(w);
+  } while (f != start);
+  if (ring.size() > 0xffffu) return ring;  // (never in a triangulation built by the stamps): not cached
+  const auto n = static_cast<std::uint16_t>(ring.size());
+  if (e->ring == kNoSlot || e->ring_capacity < n) {
+    if (e->ring != kNoSlot) {
+      ring_pool_live_ -= e->ring_capacity;
+      e->ring = kNoSlot;
+    }
+    // (No spare slot: splits are rare next to visits, and the pool is most of the cache's memory.)
+    const std::uint16_t capacity = n;
+    if (ring_pool_.size() + capacity > ring_pool_.capacity()) {
+      // Full: reclaim the garbage when it is an eighth of the pool, else grow by a quarter
+      // (amortized O(1) per slot either way, and the pool stays within about 1.4 times its
+      // live part).
+      const std::size_t garbage = ring_pool_.size() - ring_pool_live_;
+      const std::size_t live = ring_pool_live_ + capacity;
+      compact_ring_pool(garbage >= ring_pool_.size() / 8
+                            ? std::max(ring_pool_.capacity(), live + live / 8)
+                            : ring_pool_.capacity() + ring_pool_.capacity() / 4 + capacity + 64);
+      e = &erosion_list_[v->info().erosion_slot];
+    }
+    e->ring = static_cast<std::uint32_t>(ring_pool_.size());
+    e->ring_capacity = capacity;
+    ring_pool_.resize(ring_pool_.size() + capacity);
+    ring_pool_live_ += capacity;
+  }
+  std::copy(ring.begin(), ring.end(), ring_pool_.begin() + e->ring);
+  e->ring_size = n;
+  return {ring_pool_.data() + e->ring, e->ring_size};
 }
 
-void TinTerrain::touch_with_neighbours(VertexHandle v) {
-  touch(v);
-  auto c = cdt_.incident_vertices(v), done = c;
-  do {
-    if (!cdt_.is_infinite(c)) touch(c);
-  } while (++c != done);
+void TinTerrain::compact_ring_pool(std::size_t capacity) {
+  // In L_e's order, so the layout depends on the run only (never on addresses).
+  std::vector<VertexHandle> pool;
+  pool.reserve(std::max(capacity, ring_pool_live_));
+  for (ErosionEntry& e : erosion_list_) {
+    if (e.ring == kNoSlot) continue;
+    const auto from = ring_pool_.begin() + e.ring;
+    e.ring = static_cast<std::uint32_t>(pool.size());
+    pool.insert(pool.end(), from, from + e.ring_capacity);
+  }
+  ring_pool_.swap(pool);
+  ring_pool_live_ = ring_pool_.size();
 }
 
 void TinTerrain::drop_from_erosion(VertexHandle v) {
   const std::uint32_t slot = v->info().erosion_slot;
   if (slot == kNoSlot) return;
-  const VertexHandle last = erosion_list_.back();
+  if (erosion_list_[slot].ring != kNoSlot) ring_pool_live_ -= erosion_list_[slot].ring_capacity;
+  const ErosionEntry last = erosion_list_.back();
   erosion_list_[slot] = last;
-  last->info().erosion_slot = slot;
+  last.vertex->info().erosion_slot = slot;
   erosion_list_.pop_back();
   v->info().erosion_slot = kNoSlot;
 }

@@ -63,10 +63,7 @@ double TinTerrain::drop_stale_constraints(std::uint32_t generation, std::vector<
   Capture capture = begin_capture(box.expanded(4.0 * spec_.snap_m + 1e-9 * extent));
   for (const auto& [a, b] : stale) unconstrain(a, b);
   const CaptureResult measured = end_capture(capture, &region_vertices);
-  for (VertexHandle v : region_vertices) {
-    v->info().area = -1.0;
-    v->info().short_edges = 0;
-  }
+  for (VertexHandle v : region_vertices) forget_caches(v);
   // The flips change edges, not heights: only vertices by a steep face can erode now.
   for (VertexHandle v : region_vertices) {
     if (next_to_steep_face(v)) touch(v);
@@ -140,10 +137,7 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   const CaptureResult measured = end_capture(capture, &region_vertices);
   const double surface_change = measured.delta() + w.lowered_volume;
   // Constraint changes retriangulate inside the region, beyond the inserted vertices' stars.
-  for (VertexHandle v : region_vertices) {
-    v->info().area = -1.0;
-    v->info().short_edges = 0;
-  }
+  for (VertexHandle v : region_vertices) forget_caches(v);
 
   // 1d (cont.): the displaced volume, and what the retriangulation changed (tin.conserve_volume).
   const double deposit = w.lowered_volume - (spec_.conserve_volume ? surface_change : 0.0) - stale_delta_;

@@ -63,7 +63,7 @@ ModelStats TinTerrain::stats() const {
   bytes += vector_bytes(erosion_list_) + vector_bytes(simplify_list_) + vector_bytes(nbr_scratch_) +
            vector_bytes(transfer_scratch_) + vector_bytes(vertex_scratch_) + vector_bytes(face_scratch_) +
            vector_bytes(link_scratch_) + vector_bytes(work_scratch_) + vector_bytes(redundant_scratch_) +
-           vector_bytes(link_hold_scratch_);
+           vector_bytes(link_hold_scratch_) + vector_bytes(ring_pool_) + vector_bytes(ring_scratch_);
   st.bytes = bytes;
   return st;
 }
@@ -157,8 +157,21 @@ IntegrityReport TinTerrain::check() const {
     }
     if (in.erosion_slot != kNoSlot) {
       ++in_erosion;
-      if (in.erosion_slot >= erosion_list_.size() || erosion_list_[in.erosion_slot] != VertexHandle(v))
+      if (in.erosion_slot >= erosion_list_.size() || erosion_list_[in.erosion_slot].vertex != VertexHandle(v)) {
         problem("erosion list slot mismatch");
+      } else if (const ErosionEntry& e = erosion_list_[in.erosion_slot]; e.ring_size > 0) {
+        // The cached ring: v's neighbours in the circulator's order, exactly.
+        std::size_t k = 0;
+        bool same = e.ring != kNoSlot && e.ring_size <= e.ring_capacity &&
+                    std::size_t{e.ring} + e.ring_capacity <= ring_pool_.size();
+        auto c = cdt_.incident_vertices(v), done = c;
+        do {
+          if (cdt_.is_infinite(c)) continue;
+          same = same && k < e.ring_size && ring_pool_[e.ring + k] == VertexHandle(c);
+          ++k;
+        } while (same && ++c != done);
+        if (!same || k != e.ring_size) problem("a vertex's cached ring is stale");
+      }
     }
     if (in.simplify_slot != kNoSlot) {
       ++in_simplify;

@@ -171,6 +171,30 @@ TEST(ErosionRule, CapDropCountsAtMostTheGradientsDrop) {
   EXPECT_NEAR(full, 0.5 * (0.4 * d - 0.5 * d * std::tan(deg_to_rad(30.0))) * a, 1e-18);
 }
 
+// erosion_transfers takes the gradient rule's branch exactly where hypot(g) > tan_settle, also
+// within rounding of the threshold, where it decides without hypot elsewhere.
+TEST(ErosionRule, GradientRuleDecidesSteepnessAsHypotDoes) {
+  const ErosionRule rule = rule30(0.5, ErosionRuleKind::Gradient);  // tan_settle = tan_critical
+  const double d = 0.01;
+  std::array<double, 1> out{};
+  int steep = 0, gentle = 0;
+  for (double azimuth_deg = 0.0; azimuth_deg < 360.0; azimuth_deg += 7.3) {
+    const double a = deg_to_rad(azimuth_deg), ux = std::cos(a), uy = std::sin(a);
+    // A neighbour 60 degrees off the downhill direction u, lower than the edge rule allows
+    // for: only the gradient rule (run d / 2 along u) moves anything to it.
+    const double nx = d * (0.5 * ux - std::sqrt(0.75) * uy), ny = d * (0.5 * uy + std::sqrt(0.75) * ux);
+    const std::array<ErosionNeighbour, 1> n{{{-0.9 * d * rule.tan_critical, d, 1e-4, nx, ny}}};
+    for (double r : {1.0 - 1e-6, 1.0 - 1e-12, 1.0 - 4e-16, 1.0, 1.0 + 4e-16, 1.0 + 1e-12, 1.0 + 1e-6}) {
+      const SurfaceGradient g{-r * rule.tan_settle * ux, -r * rule.tan_settle * uy};
+      const bool moved = erosion_transfers(0.0, 1e-4, g, n, rule, out) > 0.0;
+      EXPECT_EQ(moved, std::hypot(g.x, g.y) > rule.tan_settle) << "azimuth " << azimuth_deg << ", ratio " << r;
+      (moved ? steep : gentle) += 1;
+    }
+  }
+  EXPECT_GT(steep, 100);
+  EXPECT_GT(gentle, 100);
+}
+
 TEST(ErosionRule, EdgeRuleIgnoresTheGradient) {
   const ErosionRule edge = rule30(0.5, ErosionRuleKind::Edge);
   const double d = 0.01;

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <span>
 #include <unordered_map>
 #include <vector>
 
@@ -62,6 +63,17 @@ using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Traits, Tds,
 using Point = Kernel::Point_3;
 using VertexHandle = Cdt::Vertex_handle;
 using FaceHandle = Cdt::Face_handle;
+
+// An entry of the erosion list L_e: the vertex, and where its ring is cached in
+// TinTerrain::ring_pool_ (its neighbours in the order gather_neighbours walks them, infinite
+// vertex left out). The ring is current while ring_size > 0: every change of v's star clears it
+// (TinTerrain::forget_caches), its slot in the pool stays for the next fill. 16 bytes.
+struct ErosionEntry {
+  VertexHandle vertex;
+  std::uint32_t ring = kNoSlot;  // offset in ring_pool_, or kNoSlot
+  std::uint16_t ring_size = 0;   // 0: not current
+  std::uint16_t ring_capacity = 0;
+};
 
 // An undirected edge by its two vertices (ordered by address).
 struct EdgeKey {
@@ -161,15 +173,47 @@ class TinTerrain final : public Terrain {
   // The cached area (computed when stale); and forgetting the caches of v and its neighbours,
   // whose stars change when v's does. Every change of the triangulation goes through
   // insert_point, remove_vertex, or a stamp, which forget the caches of the region they touched.
-  double cached_area(VertexHandle v) const;
+  double cached_area(VertexHandle v) const {  // inline: erosion reads it for every neighbour
+    VertexInfo& in = v->info();
+    if (in.area < 0.0) in.area = vertex_area(v);
+    return in.area;
+  }
   void forget_star(VertexHandle v);
+  // v's cached area, short-edge flag and ring forgotten: its star changed.
+  void forget_caches(VertexHandle v) {
+    VertexInfo& in = v->info();
+    in.area = -1.0;
+    in.short_edges = 0;
+    if (in.erosion_slot != kNoSlot) erosion_list_[in.erosion_slot].ring_size = 0;
+  }
   bool has_long_edges(VertexHandle v) const;
   Capture begin_capture(const Aabb2& box);
   CaptureResult end_capture(Capture& c, std::vector<VertexHandle>* region_vertices = nullptr);
   // Vertices inside `box` (a traversal of the faces overlapping it).
   void collect_vertices(const Aabb2& box, std::vector<VertexHandle>& out);
-  void touch(VertexHandle v);                  // joins L_e (idle count reset)
-  void touch_with_neighbours(VertexHandle v);  // v and its neighbours join L_e
+  void touch(VertexHandle v) {  // joins L_e (idle count reset); inline: erosion's hottest call
+    VertexInfo& in = v->info();
+    in.idle = 0;
+    if (in.erosion_slot != kNoSlot) return;
+    in.erosion_slot = static_cast<std::uint32_t>(erosion_list_.size());
+    erosion_list_.push_back(ErosionEntry{v});
+  }
+  void touch_with_neighbours(VertexHandle v) {  // v and its neighbours join L_e
+    touch(v);
+    for (VertexHandle w : ring_of(v)) touch(w);
+  }
+  // The finite neighbours of v, a vertex of L_e, counter-clockwise from v->face() (the order
+  // of CGAL's vertex circulator): cached in ring_pool_ until v's star changes. O(1) amortized
+  // when current, O(degree) to refill; the span lasts until the pool grows.
+  std::span<const VertexHandle> ring_of(VertexHandle v) {
+    const ErosionEntry& e = erosion_list_[v->info().erosion_slot];
+    if (e.ring_size > 0) return {ring_pool_.data() + e.ring, e.ring_size};
+    return fill_ring(v);
+  }
+  std::span<const VertexHandle> fill_ring(VertexHandle v);  // ring_of when not current
+  // The live rings moved to a new pool of this capacity (at least what they need), the
+  // garbage left behind. O(L_e + live rings).
+  void compact_ring_pool(std::size_t capacity);
   void drop_from_erosion(VertexHandle v);
   void add_to_simplify(VertexHandle v);
   void drop_from_simplify(VertexHandle v);
@@ -241,8 +285,12 @@ class TinTerrain final : public Terrain {
 
   Cdt cdt_;
   std::unordered_map<EdgeKey, std::uint32_t, EdgeKeyHash> generations_;  // constrained edges
-  std::vector<VertexHandle> erosion_list_;                               // L_e
-  std::vector<VertexHandle> simplify_list_;                              // L_r
+  std::vector<ErosionEntry> erosion_list_;                               // L_e
+  // The cached rings of L_e's vertices (ErosionEntry::ring), and how many of its slots belong
+  // to a vertex still in L_e: the rest is garbage, compacted when it outgrows the live part.
+  std::vector<VertexHandle> ring_pool_;
+  std::size_t ring_pool_live_ = 0;
+  std::vector<VertexHandle> simplify_list_;  // L_r
 
   std::size_t hull_vertices_ = 0;  // border vertices (all on the convex hull)
   mutable VertexHandle hint_;
@@ -262,6 +310,7 @@ class TinTerrain final : public Terrain {
   std::vector<VertexHandle> redundant_scratch_;  // simplify: vertices to remove
   std::vector<VertexHandle> link_hold_scratch_;  // simplify: the removed vertex's link
   std::vector<double> link_z_scratch_;           // simplify: the link's heights before the give-back
+  std::vector<VertexHandle> ring_scratch_;       // ring_of: the walk before it is cached
 };
 
 // Area of a finite face projected on the xy plane (positive: faces are counter-clockwise).
