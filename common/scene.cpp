@@ -432,7 +432,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   s.tin.curvature_tolerance_m = f.number("tin.curvature_tolerance_m", 0.0, closed(0.0, 1e6));
   s.tin.refine_min_m = f.number("tin.refine_min_m", 0.0, closed(0.0, extent));
   s.tin.planar_tolerance_m = f.number("tin.planar_tolerance_m", 0.0, closed(0.0, 1e6));
-  s.tin.coarsen = f.boolean("tin.coarsen", false);
+  s.tin.coarsen = f.boolean("tin.coarsen", true);
 
   // [grid]
   s.grid.cell_m = f.number("grid.cell_m", 0.005, positive(extent));

@@ -70,12 +70,12 @@ struct TinSpec {
   // whose error exceeds curvature_tolerance_m, down to refine_min_m (0: refine_m / 2; at least refine_m / 4). 0: off.
   double curvature_tolerance_m = 0.0;
   double refine_min_m = 0.0;
-  // coarsen: simplification also removes settled vertices within planar_tolerance_m of the
-  // plane fitted to their neighbours (volume-preserving; 0: tolerance_m / 4). Off by default:
-  // with the edge-wise erosion rule the coarser mesh settles with triangles up to a few
-  // degrees steeper than critical. Off keeps the paper's step 3 alone (alpha_flat_deg).
+  // coarsen: once the terrain is at rest, simplification also removes vertices within
+  // planar_tolerance_m of the plane fitted to their neighbours (volume-preserving; 0:
+  // tolerance_m / 4), never tilting a triangle past the stable slope. Off keeps the paper's
+  // step 3 alone (alpha_flat_deg, every step), as the alpha_flat experiment does.
   double planar_tolerance_m = 0.0;
-  bool coarsen = false;
+  bool coarsen = true;
 };
 
 enum class GridStorage { Float, Double };

@@ -63,7 +63,7 @@ std::string scene_key_meaning(const std::string& key) {
       {"tin.refine_min_m",
        "the shortest edge that split may make (at least a quarter of tin.refine_m); 0: half of tin.refine_m"},
       {"tin.planar_tolerance_m", "height tolerance of the coarsening; 0: tin.tolerance_m / 4"},
-      {"tin.coarsen", "simplification also removes settled vertices near the plane of their neighbours"},
+      {"tin.coarsen", "at rest, simplification also removes vertices near the plane of their neighbours"},
       {"grid.cell_m", "node spacing"},
       {"grid.storage", "height storage type"},
       {"grid.neighbours", "erosion stencil (4 or 8)"},

@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """alpha_flat: vertex count and height error against the simplification threshold (the
-trade-off of the paper's Section 5), on the dunes scene with its curved stroke."""
+trade-off of the paper's Section 5), on the dunes scene with its curved stroke; the paper's
+step 3 alone (tin.coarsen = false)."""
 import sbrun
 
 SCENE = sbrun.SCENES / "dunes.toml"
@@ -13,7 +14,7 @@ def run(ctx):
     alphas = ctx.profile["alpha"]
     if 0.0 not in alphas:
         alphas = [0.0] + list(alphas)
-    jobs = [(SCENE, "tin", f"alpha_flat/tin-a{a:g}", [f"tin.alpha_flat_deg={a}", sbrun.PAPER_RULE]) for a in alphas]
+    jobs = [(SCENE, "tin", f"alpha_flat/tin-a{a:g}", [f"tin.alpha_flat_deg={a}", "tin.coarsen=false", sbrun.PAPER_RULE]) for a in alphas]
     s = ctx.run_many("alpha_flat", jobs)
     rasters = []
     for j in jobs:

@@ -175,13 +175,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
         }
         report.volume_moved_m3 += total;
       } else if (++v->info().idle >= idle_passes_) {
-        drop_from_erosion(v);
-        // Settled: v and its neighbours (whose rings may now be all settled) are candidates
-        // for coarsening.
-        if (spec_.coarsen) {
-          add_to_simplify(v);
-          for (VertexHandle w : vertex_scratch_) add_to_simplify(w);
-        }
+        drop_from_erosion(v);  // (coarsening scans every vertex once the terrain is at rest)
       }
     }
   }

@@ -32,7 +32,8 @@
 //                     neighbours in CGAL's circulator order, walked again only after the star
 //                     changed; check() compares it with the star), heights and cached areas
 //                     fresh; no allocation per visit (scratch and pool grow amortized)
-//   simplify          detect O(|L_r| * degree); removal O(degree) per vertex
+//   simplify          detect O(|L_r| * degree); removal O(degree) per vertex; with
+//                     tin.coarsen, once per rest after activity: detect O(n * degree)
 //   one step          stamp + 4 erosion passes + simplify: 0.6 to 0.7 ms CPU at every n from
 //                     10^3 to 10^6, on tin.initial_points TINs with their border points too,
 //                     log-log slope -0.006 (tests/bench/tin_step_bench.cpp; 0.73 ms on the

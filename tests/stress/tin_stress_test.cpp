@@ -1,7 +1,7 @@
 // Stress tests of the TIN: the inputs that trip CGAL's constrained triangulation when
 // constraints touch or cross (CGAL issues 2999, 3263, 5439) -- crossing strokes, a thousand
-// stamps at one spot, collinear and near-duplicate contours, random strokes -- with check()
-// after every step, and the same with curvature refinement. About 30 s in Release.
+// stamps at one spot, collinear and near-duplicate contours, random strokes, coarsening at rest --
+// with check() after every step, and the same with curvature refinement. About 30 s in Release.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -142,6 +142,53 @@ TEST(TinStress, CrossingStrokesWithCurvatureRefinement) {
     }
     EXPECT_NEAR(run.terrain->volume(), v0, 1e-12 * v0);
     EXPECT_GT(run.terrain->stats().vertices, plain.terrain->stats().vertices) << "it refined";
+  }
+}
+
+// Strokes that each settle to rest, with check() and the volume after every step; returns
+// the vertices removed and the steepest edge after each rest.
+std::pair<std::size_t, std::vector<double>> strokes_to_rest(const char* text, bool coarsen) {
+  Runner run(parse_scene(text, "stress", {std::string("tin.coarsen=") + (coarsen ? "true" : "false")}));
+  const double v0 = run.terrain->volume();
+  std::size_t removed = 0;
+  std::vector<double> slopes;
+  const std::vector<std::vector<Vec2>> paths = {
+      {{0.05, 0.05}, {0.25, 0.25}}, {{0.05, 0.25}, {0.25, 0.05}}, {{0.02, 0.15}, {0.28, 0.15}}};
+  for (const auto& path : paths) {
+    Stroke stroke = run.scene.stroke;
+    stroke.path_m = path;
+    stroke.spacing_m = 0.008;
+    for (const ToolStamp& st : run.schedule(stroke).stamps) {
+      if (!run.step(st)) return {removed, slopes};
+      EXPECT_NEAR(run.terrain->volume(), v0, 1e-12 * v0);
+    }
+    // Settle to rest: the simplification after the last erosion coarsens (and cascades).
+    for (int guard = 0; guard < 2000 && run.terrain->stats().active > 0; ++guard) {
+      run.terrain->erode(run.rule, ErosionBudget{64});
+      if (!run.ok("settling erode")) return {removed, slopes};
+      removed += run.terrain->simplify(SimplifyParams{run.scene.tin.alpha_flat_deg}).removed;
+      if (!run.ok("settling simplify")) return {removed, slopes};
+      EXPECT_NEAR(run.terrain->volume(), v0, 1e-12 * v0);
+    }
+    EXPECT_EQ(run.terrain->stats().active, 0u) << "settles";
+    slopes.push_back(run.terrain->max_slope_deg());
+  }
+  std::printf("%s, coarsen %d: %zu removed at rest, %zu vertices, drift %.3g\n", text == kScene ? "flat" : "dunes",
+              coarsen, removed, run.terrain->stats().vertices, (run.terrain->volume() - v0) / v0);
+  return {removed, slopes};
+}
+
+TEST(TinStress, CoarseningAtRestKeepsVolumeSlopeAndIntegrity) {
+  for (const char* text : {kScene, kDunes}) {
+    const Scene scene = parse_scene(text, "stress");
+    const double stable = scene.material.critical_angle_deg + scene.erosion.settle_tolerance_deg + 1e-6;
+    const auto [kept, plain] = strokes_to_rest(text, false);
+    const auto [removed, coarse] = strokes_to_rest(text, true);
+    EXPECT_GT(removed, 0u) << "coarsening acts at rest";
+    ASSERT_EQ(coarse.size(), plain.size());
+    // The dunes start steeper than critical where no stroke passes: no steeper than that.
+    for (std::size_t k = 0; k < coarse.size(); ++k)
+      EXPECT_LE(coarse[k], std::max(stable, plain[k] + 1e-6)) << "coarsening tilts no edge past the stable slope";
   }
 }
 

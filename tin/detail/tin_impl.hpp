@@ -265,9 +265,13 @@ class TinTerrain final : public Terrain {
   // errs by about length x jump / 4). Reads v's ring from gather_neighbours and the transfers
   // erosion computed on it; returns whether it split. O(ring).
   bool refine_crease(VertexHandle v);
-  // simplify.cpp: whether a triangle of the retriangulated hole (all its vertices in `link`)
-  // is steeper than the stable slope.
-  bool hole_is_steep(const std::vector<VertexHandle>& link) const;
+  // simplify.cpp: whether a triangle incident to a vertex of `link` (only those of the
+  // retriangulated hole with hole_only, else also the ring around it) is steeper than the
+  // stable slope. O(|link|^2 * degree).
+  bool has_steep_triangle(const std::vector<VertexHandle>& link, bool hole_only) const;
+  // simplify.cpp: one detection (over L_r, or every vertex with scan_all) and removal;
+  // `coarsen` allows the planar rule.
+  void simplify_round(double tan_alpha, bool coarsen, bool scan_all, SimplifyReport& report);
   // build.cpp
   void insert_corners(const std::function<double(const Vec2&)>& z);
   void finish_build();
@@ -281,10 +285,11 @@ class TinTerrain final : public Terrain {
   // refine_m_ are split too where length x facet-gradient jump / 4 exceeds the tolerance.
   double fine_m_ = 0.0;
   double curvature_tolerance_m_ = 0.0;
-  double tool_size_m_ = 0.0;   // characteristic radius of the scene's tool
-  double settle_dz_ = 0.0;     // coarsening: removals may not make an edge steeper by this much
-  double tan_critical_ = 0.0;  // the scene material's, for coarsening
-  double tan_settle_ = 0.0;    // and the steepest stable slope (erosion.settle_tolerance_deg)
+  double tool_size_m_ = 0.0;       // characteristic radius of the scene's tool
+  double settle_dz_ = 0.0;         // coarsening: removals may not make an edge steeper by this much
+  double tan_critical_ = 0.0;      // the scene material's, for coarsening
+  double tan_settle_ = 0.0;        // and the steepest stable slope (erosion.settle_tolerance_deg)
+  bool rest_scan_pending_ = true;  // coarsening: scan every vertex at the next rest
   TerrainKind kind_ = TerrainKind::Flat;
   double base_height_m_ = 0.0;
 
@@ -314,6 +319,7 @@ class TinTerrain final : public Terrain {
   std::vector<VertexHandle> work_scratch_;       // erosion: the pass's copy of L_e
   std::vector<VertexHandle> redundant_scratch_;  // simplify: vertices to remove
   std::vector<VertexHandle> link_hold_scratch_;  // simplify: the removed vertex's link
+  std::vector<double> link_z_scratch_;           // simplify: the link's heights before the give-back
   std::vector<VertexHandle> ring_scratch_;       // ring_of: the walk before it is cached
 };
 
