@@ -130,7 +130,7 @@ notes); the tables below are this run's.
   re-triangulated region, convex tools kept corners the mesh cannot resolve, contour pieces were
   subdivided far below the refinement length, and every erosion visit walked the triangulation for its
   neighbours; with those fixed (a ring cached per active vertex between passes, no allocation per visit:
-  0.31 -> 0.20 us per visit) the TIN trench step went from 8.5-9.5x to 5.2-5.5x the grid's. What remains
+  0.31 -> 0.20 us per visit) the TIN trench step went from 8.5-9.5x to 5.0-5.5x the grid's. What remains
   is the price of a visit (scattered vertex records, about five times a grid node's time) and of
   re-triangulating around every stamp (about 0.4 ms of a 1.3 ms step): the method.
 - **TIN pile with the default (gradient) rule** (flank about 27 degrees, roundness 0.075, RMSE several
