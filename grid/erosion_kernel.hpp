@@ -127,6 +127,26 @@ struct NodeClass {
   // Central differences, one-sided on the border: g = (z[+] - z[-]) * inv_run.
   std::ptrdiff_t gx_hi = 0, gx_lo = 0, gy_hi = 0, gy_lo = 0;
   double inv_run_x = 0.0, inv_run_y = 0.0;
+
+  // Slot s holds a neighbour at index offset `index_offset`, of area `area_j`, at (dx, dy) m.
+  void set_neighbour(int s, std::ptrdiff_t index_offset, double area_j, double dx, double dy, double tan_critical,
+                     double tan_settle) {
+    const double d = std::hypot(dx, dy);
+    offset[s] = index_offset;
+    area[s] = area_j;
+    inv_area[s] = 1.0 / area_j;
+    weight[s] = area_i * area_j / (area_i + area_j);
+    crit[s] = d * tan_critical;
+    margin[s] = d * (tan_settle - tan_critical);
+    ox[s] = dx;
+    oy[s] = dy;
+  }
+  // Slot s has no neighbour: it reads the centre and never receives.
+  void set_missing(int s) {
+    offset[s] = 0;
+    margin[s] = std::numeric_limits<double>::infinity();
+    crit[s] = 0.0;
+  }
 };
 
 // The classes of one layout, stencil and rule; built in O(nx + ny) (microseconds).

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "grid/erosion_kernel.hpp"
+#include "grid/stencil.hpp"
 
 namespace sb::grid {
 
@@ -36,9 +37,6 @@ ErosionTables::ErosionTables(const GridLayout& layout, int neighbours, const Ero
       tan_settle_(rule.tan_settle) {
   if (neighbours != 4 && neighbours != 8)
     throw std::invalid_argument("grid stencil: neighbours must be 4 or 8, not " + std::to_string(neighbours));
-  // Same order as Stencil::make: part of what makes erosion deterministic.
-  const int offsets[8][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, 1}, {1, -1}, {-1, -1}};
-  const double margin = rule.tan_settle - rule.tan_critical;
   const auto nx = static_cast<std::ptrdiff_t>(layout.nx);
   // The axis codes that occur: those of the first two and last two nodes, and one inside.
   const auto codes = [](std::size_t n) {
@@ -61,26 +59,15 @@ ErosionTables::ErosionTables(const GridLayout& layout, int neighbours, const Ero
       c.area_i = ax.own * ay.own;
       c.inv_area_i = 1.0 / c.area_i;
       for (int s = 0; s < 8; ++s) {
-        const int ox = offsets[s][0], oy = offsets[s][1];
+        const int ox = kStencilOffsets[s][0], oy = kStencilOffsets[s][1];
         const double wx = ox == 0 ? ax.own : ox > 0 ? ax.hi : ax.lo;
         const double wy = oy == 0 ? ay.own : oy > 0 ? ay.hi : ay.lo;
-        const bool present = s < neighbours && wx > 0.0 && wy > 0.0;
-        const double d = std::hypot(ox * layout.dx, oy * layout.dy);
         c.ox[s] = ox * layout.dx;
         c.oy[s] = oy * layout.dy;
-        if (!present) {
-          c.offset[s] = 0;
-          c.margin[s] = std::numeric_limits<double>::infinity();
-          c.crit[s] = 0.0;
-          continue;
-        }
-        const double area_j = wx * wy;
-        c.offset[s] = ox + oy * nx;
-        c.area[s] = area_j;
-        c.inv_area[s] = 1.0 / area_j;
-        c.weight[s] = c.area_i * area_j / (c.area_i + area_j);
-        c.crit[s] = d * rule.tan_critical;
-        c.margin[s] = d * margin;
+        if (s < neighbours && wx > 0.0 && wy > 0.0)
+          c.set_neighbour(s, ox + oy * nx, wx * wy, ox * layout.dx, oy * layout.dy, rule.tan_critical, rule.tan_settle);
+        else
+          c.set_missing(s);
       }
       c.gx_hi = ax.has_hi ? 1 : 0;
       c.gx_lo = ax.has_lo ? -1 : 0;

@@ -3,6 +3,8 @@
 #include <array>
 #include <stdexcept>
 
+#include "grid/stencil.hpp"
+
 namespace sb::grid {
 
 MultiresAxis MultiresAxis::coarsen(const MultiresAxis& finer, bool halve) {
@@ -80,9 +82,6 @@ MultiresClasses::MultiresClasses(const MultiresAxis& x, const MultiresAxis& y, i
   cy_ = categories(y, rep_y);
   ny_classes_ = rep_y.size();
   classes_.resize(rep_x.size() * rep_y.size());
-  // Same order as Stencil::make and ErosionTables.
-  const int offsets[8][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, 1}, {1, -1}, {-1, -1}};
-  const double margin = fine.tan_settle() - fine.tan_critical();
   const auto nx = static_cast<std::ptrdiff_t>(x.size());
   for (std::size_t a = 0; a < rep_x.size(); ++a) {
     for (std::size_t b = 0; b < rep_y.size(); ++b) {
@@ -91,26 +90,13 @@ MultiresClasses::MultiresClasses(const MultiresAxis& x, const MultiresAxis& y, i
       c.area_i = x.weight[ix] * y.weight[iy];
       c.inv_area_i = 1.0 / c.area_i;
       for (int s = 0; s < 8; ++s) {
-        const int ox = offsets[s][0], oy = offsets[s][1];
+        const int ox = kStencilOffsets[s][0], oy = kStencilOffsets[s][1];
         const std::size_t jx = ix + static_cast<std::size_t>(ox), jy = iy + static_cast<std::size_t>(oy);
-        const bool present = s < neighbours && jx < x.size() && jy < y.size();  // wraps below 0
-        if (!present) {
-          c.offset[s] = 0;
-          c.margin[s] = std::numeric_limits<double>::infinity();
-          c.crit[s] = 0.0;
-          continue;
-        }
-        const double area_j = x.weight[jx] * y.weight[jy];
-        const double ddx = x.position[jx] - x.position[ix], ddy = y.position[jy] - y.position[iy];
-        const double d = std::hypot(ddx, ddy);
-        c.offset[s] = ox + oy * nx;
-        c.area[s] = area_j;
-        c.inv_area[s] = 1.0 / area_j;
-        c.weight[s] = c.area_i * area_j / (c.area_i + area_j);
-        c.crit[s] = d * fine.tan_critical();
-        c.margin[s] = d * margin;
-        c.ox[s] = ddx;
-        c.oy[s] = ddy;
+        if (s < neighbours && jx < x.size() && jy < y.size())  // (wraps below 0)
+          c.set_neighbour(s, ox + oy * nx, x.weight[jx] * y.weight[jy], x.position[jx] - x.position[ix],
+                          y.position[jy] - y.position[iy], fine.tan_critical(), fine.tan_settle());
+        else
+          c.set_missing(s);
       }
       const bool xlo = ix > 0, xhi = ix + 1 < x.size(), ylo = iy > 0, yhi = iy + 1 < y.size();
       c.gx_hi = xhi ? 1 : 0;

@@ -11,6 +11,10 @@
 
 namespace sb::grid {
 
+// The neighbours' (x, y) index offsets, axis ones first. The order is fixed: part of what
+// makes erosion deterministic, shared by the stencil and the erosion kernel's node classes.
+inline constexpr int kStencilOffsets[8][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, 1}, {1, -1}, {-1, -1}};
+
 struct Stencil {
   int size = 8;
   std::array<int, 8> ox{}, oy{};       // index offsets
@@ -22,11 +26,9 @@ struct Stencil {
     Stencil s;
     s.size = neighbours;
     const double d = layout.diagonal();
-    // Fixed order: part of what makes erosion deterministic.
-    const int offsets[8][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}, {1, 1}, {-1, 1}, {1, -1}, {-1, -1}};
     for (int i = 0; i < 8; ++i) {
-      s.ox[i] = offsets[i][0];
-      s.oy[i] = offsets[i][1];
+      s.ox[i] = kStencilOffsets[i][0];
+      s.oy[i] = kStencilOffsets[i][1];
       s.distance_m[i] = i < 2 ? layout.dx : i < 4 ? layout.dy : d;
     }
     return s;
