@@ -262,7 +262,9 @@ class TinTerrain final : public Terrain {
   // v's neighbours (vertex_scratch_) with heights, distances and areas (nbr_scratch_); returns
   // v's area.
   double gather_neighbours(VertexHandle v);
-  // Splits v's edges longer than refine_m_ until none is; returns the number of splits.
+  // Splits v's edges longer than refine_m_ until none is left that may be split (a constrained
+  // edge only where its middle is exactly on it, no edge whose middle a facing vertex crowds);
+  // returns the number of splits.
   std::size_t refine_around(VertexHandle v);
   // Curvature refinement: splits v's longest edge longer than fine_m_ that sand crosses (a
   // transfer in transfer_scratch_) and across which the gradients of its two facets jump by
