@@ -106,7 +106,9 @@
 
 #include "common/erosion.hpp"
 #include "common/terrain.hpp"
+#include "grid/erosion_lanes_avx512.hpp"
 #include "grid/grid_layout.hpp"
+#include "grid/row_bits.hpp"
 
 // _mm256_movemask_pd, in the AVX2 functions only (compiled for AVX2 by their target attribute).
 #include <immintrin.h>
@@ -353,69 +355,16 @@ template <int N, class Store>
 }
 
 // Which sweep erode_ordered runs (tests force one; Auto is what the terrains use). Dense
-// sweeps the members' row spans; DenseBaseline is Dense with its rows classed in SSE2
-// registers even where the CPU has AVX2 (tests: both give the same heights, bit for bit).
-enum class SweepPath { Auto, ActiveSet, Dense, DenseBaseline };
+// sweeps the members' row spans with the widest lanes the CPU has; DenseAvx2 is Dense with
+// AVX2 lanes even where the CPU has AVX-512; DenseBaseline is Dense with its rows classed in
+// SSE2 registers and one visit at a time (tests: all give the same heights, bit for bit).
+enum class SweepPath { Auto, ActiveSet, Dense, DenseAvx2, DenseBaseline };
 
 // Whether a pass sweeps the members' row spans (dense_pass) rather than the members: a dense
 // pass costs about a sixth of an active-set visit per node it skips (instructions,
 // callgrind; tests/bench/grid_bench.cpp), so it pays once the members fill about an eighth of
 // the spans from the first to the last member of each row.
 inline bool dense_pass_pays(std::size_t active, std::size_t span_nodes) { return active * 8 >= span_nodes; }
-
-// Bits of a row's flags, one per node (x at word x / 64, bit x % 64).
-inline bool bit_at(const std::uint64_t* bits, std::size_t x) { return (bits[x / 64] >> (x % 64)) & 1u; }
-// Ors the `count` low bits of `m` in at bit x (count <= 4; may straddle two words).
-inline void or_bits(std::uint64_t* bits, std::size_t x, std::uint64_t m) {
-  bits[x / 64] |= m << (x % 64);
-  if (x % 64 > 60) bits[x / 64 + 1] |= m >> (64 - x % 64);
-}
-// Sets bits [a, b].
-inline void set_bits(std::uint64_t* bits, std::size_t a, std::size_t b) {
-  for (std::size_t w = a / 64; w <= b / 64; ++w) {
-    const unsigned lo = w == a / 64 ? a % 64 : 0, hi = w == b / 64 ? b % 64 : 63;
-    bits[w] |= (hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & (~std::uint64_t{0} << lo);
-  }
-}
-// Sets bits ix - 2 .. ix + 2 (those below 0 dropped; `bits` must hold bit ix + 2).
-[[gnu::always_inline]] inline void near_bits(std::uint64_t* bits, std::size_t ix) {
-  const std::size_t lo = ix >= 2 ? ix - 2 : 0;
-  const std::uint64_t m = ix >= 2 ? 0x1Fu : 0x1Fu >> (2 - ix);
-  bits[lo / 64] |= m << (lo % 64);
-  if (lo % 64 > 59) bits[lo / 64 + 1] |= m >> (64 - lo % 64);
-}
-// The bits of word w for nodes x in [x0, x1].
-[[gnu::always_inline]] inline std::uint64_t word_range(std::size_t w, std::size_t x0, std::size_t x1) {
-  const unsigned lo = w == x0 / 64 ? x0 % 64 : 0, hi = w == x1 / 64 ? x1 % 64 : 63;
-  return (hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & (~std::uint64_t{0} << lo);
-}
-// The bits of word w for nodes x with x % 3 == r (64 = 1 mod 3: the pattern shifts by one per word).
-[[gnu::always_inline]] inline std::uint64_t columns_mod3(std::size_t r, std::size_t w) {
-  constexpr std::uint64_t kEvery3 = 0x9249249249249249ull;  // bits 0, 3, ..., 63
-  return kEvery3 << ((r + 3 - w % 3) % 3);
-}
-// The first node x in [from, to] with x % 3 == r and its bit set (false: none). O(words).
-[[gnu::always_inline]] inline bool next_in_class(const std::uint64_t* bits, std::size_t r, std::size_t from,
-                                                 std::size_t to, std::size_t& x) {
-  if (from > to) return false;
-  for (std::size_t w = from / 64; w <= to / 64; ++w)
-    if (const std::uint64_t m = bits[w] & columns_mod3(r, w) & word_range(w, from, to)) {
-      x = w * 64 + static_cast<std::size_t>(std::countr_zero(m));
-      return true;
-    }
-  return false;
-}
-// The last such node in [from, to].
-[[gnu::always_inline]] inline bool prev_in_class(const std::uint64_t* bits, std::size_t r, std::size_t from,
-                                                 std::size_t to, std::size_t& x) {
-  if (from > to) return false;
-  for (std::size_t w = to / 64 + 1; w-- > from / 64;)
-    if (const std::uint64_t m = bits[w] & columns_mod3(r, w) & word_range(w, from, to)) {
-      x = w * 64 + 63 - static_cast<std::size_t>(std::countl_zero(m));
-      return true;
-    }
-  return false;
-}
 
 // The thresholds of the interior class, copied (the flags could alias the class as far as
 // the compiler knows).
@@ -505,6 +454,16 @@ inline bool has_avx2() {
   return yes;
 }
 
+// The dense pass's vector width: rows classed two (SSE2), four (AVX2) or eight (AVX-512)
+// nodes at a time, and visits one at a time (SSE2), four (AVX2) or up to eight (AVX-512) at once.
+enum class Lanes { Sse2, Avx2, Avx512 };
+// The widest the CPU runs, at most what `path` asks for.
+inline Lanes lanes_for(SweepPath path) {
+  if (path == SweepPath::DenseBaseline) return Lanes::Sse2;
+  if (path != SweepPath::DenseAvx2 && has_avx512()) return Lanes::Avx512;
+  return has_avx2() ? Lanes::Avx2 : Lanes::Sse2;
+}
+
 // One dense pass, in place (Gauss-Seidel), rows in the direction the active set's next
 // sweep would take: in each row, every node from the first to the last member (the row's
 // span) is visited once. Like the active-set sweep it is live: a row's span also covers the
@@ -540,7 +499,7 @@ inline bool has_avx2() {
 // unstable node -- plus O(words of the visited rows) to find the spans and update the set.
 template <int N, bool Gradient, class Store, class Active>
 void dense_pass(Store& store, Active& active, const typename Active::Spans& spans, const ErosionTables& t,
-                ErosionReport& report, double& moved, bool wide = true) {
+                ErosionReport& report, double& moved, Lanes lanes) {
   const std::size_t nx = t.layout().nx, ny = t.layout().ny;
   const unsigned pass = active.next_sweep();
   const bool y_up = pass % 2 == 0;
@@ -551,7 +510,6 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
   constexpr bool kContiguous = requires { store.data(); };
   // The row's unstable nodes, one bit each (plus a word: or_bits may write one past the row).
   std::vector<std::uint64_t> flags(words + 1, 0);
-  const bool avx2 = wide && has_avx2();
   std::size_t prev_lo = 1, prev_hi = 0;  // span of the previous row's transfers (empty)
   std::size_t visited_rows = 0;
   const std::size_t first = y_up ? spans.y0 : spans.y1;
@@ -585,7 +543,9 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
         if (skip_lo <= skip_hi) {
           const RowThresholds<N> c(middle, t.tan_settle() * t.tan_settle());
           const auto* row = store.data() + iy * nx;
-          if (avx2)
+          if (lanes == Lanes::Avx512)
+            unstable_bits_avx512<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
+          else if (lanes == Lanes::Avx2)
             unstable_bits_avx2<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
           else
             unstable_bits<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
@@ -614,7 +574,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     };
     // Three phases, one per column modulo 3, each in the sweep's direction; on a contiguous
     // store, four nodes of a phase at once where they are interior nodes of the span.
-    const bool in_fours = avx2 && !Gradient && skip_lo <= skip_hi && nx >= 13;
+    const bool in_groups = lanes != Lanes::Sse2 && !Gradient && skip_lo <= skip_hi && nx >= 13;
     const std::size_t four_lo = std::max<std::size_t>(x0, 2), four_hi = std::min(x1, nx - 3);
     for (std::size_t p = 0; p < 3; ++p) {
       const std::size_t r = x_up ? (x0 + p) % 3 : (x1 + 3 - p) % 3;
@@ -623,7 +583,28 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       while (x_up ? next_in_class(must, r, from, x1, ix) : prev_in_class(must, r, x0, from, ix)) {
         const std::size_t lowest = x_up ? ix : ix - std::min<std::size_t>(ix, 9);
         if constexpr (kContiguous) {
-          if (in_fours && lowest >= four_lo && lowest + 9 <= four_hi) {
+          // Up to eight nodes of the phase from ix on, in the span's interior (AVX-512).
+          const std::size_t room = !in_groups || lanes != Lanes::Avx512 || ix < four_lo || ix > four_hi ? 0
+                                   : x_up ? (four_hi - ix) / 3 + 1
+                                          : (ix - four_lo) / 3 + 1;
+          if (room >= 2) {
+            const std::size_t count = std::min<std::size_t>(8, room);
+            const std::size_t a = x_up ? ix : ix - 3 * (count - 1);
+            double given[8];
+            std::int64_t transfers[8];
+            for (unsigned b =
+                     erosion_visit8<N>(store, t.fraction(), nx, iy * nx + a, count, middle, !x_up, given, transfers);
+                 b != 0;) {
+              const int l = x_up ? std::countr_zero(b) : 31 - std::countl_zero(b);
+              b &= ~(1u << l);
+              transferred(a + 3 * static_cast<std::size_t>(l), VisitResult{static_cast<int>(transfers[l]), given[l]});
+            }
+            const std::size_t last = x_up ? a + 3 * (count - 1) : a;
+            if (x_up ? last >= x1 : last <= x0) break;
+            from = x_up ? last + 1 : last - 1;
+            continue;
+          }
+          if (in_groups && lanes == Lanes::Avx2 && lowest >= four_lo && lowest + 9 <= four_hi) {
             VisitResult v[4];
             erosion_visit4<N>(store, t, iy * nx + lowest, middle, !x_up, v);
             for (int i = 0; i < 4; ++i) {
@@ -675,11 +656,11 @@ ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t
     ++report.passes;
     if (path != SweepPath::ActiveSet) {
       const typename Active::Spans spans = active.spans();
-      const bool forced = path == SweepPath::Dense || path == SweepPath::DenseBaseline;
+      const bool forced = path == SweepPath::Dense || path == SweepPath::DenseAvx2 || path == SweepPath::DenseBaseline;
       const bool dense = forced || (dense_pass_pays(active.size(), spans.nodes) &&
                                     budget.max_updates - report.updates >= 2 * spans.nodes);
       if (dense) {
-        dense_pass<N, Gradient>(store, active, spans, t, report, moved, path != SweepPath::DenseBaseline);
+        dense_pass<N, Gradient>(store, active, spans, t, report, moved, lanes_for(path));
         continue;
       }
     }
