@@ -512,6 +512,8 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
   std::vector<std::uint64_t> flags(words + 1, 0);
   std::size_t prev_lo = 1, prev_hi = 0;  // span of the previous row's transfers (empty)
   std::size_t visited_rows = 0;
+  double moved_sum = moved;  // in visiting order, in a register
+  std::size_t transfer_count = 0;
   const std::size_t first = y_up ? spans.y0 : spans.y1;
   for (std::size_t iy = first; iy < ny; iy = y_up ? iy + 1 : iy - 1) {  // iy - 1 wraps below 0: stops
     std::size_t x0 = nx, x1 = 0;
@@ -560,8 +562,8 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     }
     std::size_t row_lo = nx, row_hi = 0;  // span of this row's transfers (empty)
     const auto transferred = [&](std::size_t ix, const VisitResult& v) {
-      report.transfers += static_cast<std::size_t>(v.transfers);
-      moved += v.moved;
+      transfer_count += static_cast<std::size_t>(v.transfers);
+      moved_sum += v.moved;
       moved_row[ix / 64] |= std::uint64_t{1} << (ix % 64);
       row_lo = std::min(row_lo, ix);
       row_hi = std::max(row_hi, ix);
@@ -591,13 +593,21 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
             const std::size_t count = std::min<std::size_t>(8, room);
             const std::size_t a = x_up ? ix : ix - 3 * (count - 1);
             double given[8];
-            std::int64_t transfers[8];
-            for (unsigned b =
-                     erosion_visit8<N>(store, t.fraction(), nx, iy * nx + a, count, middle, !x_up, given, transfers);
-                 b != 0;) {
-              const int l = x_up ? std::countr_zero(b) : 31 - std::countl_zero(b);
-              b &= ~(1u << l);
-              transferred(a + 3 * static_cast<std::size_t>(l), VisitResult{static_cast<int>(transfers[l]), given[l]});
+            std::size_t transfers = 0;
+            if (const unsigned b =
+                    erosion_visit8<N>(store, t.fraction(), nx, iy * nx + a, count, middle, !x_up, given, transfers)) {
+              // What transferred() does per node, for the group at once (volumes in visiting order).
+              for (unsigned rest = b; rest != 0;) {
+                const int l = x_up ? std::countr_zero(rest) : 31 - std::countl_zero(rest);
+                rest &= ~(1u << l);
+                moved_sum += given[l];
+              }
+              transfer_count += transfers;
+              const std::uint64_t at = kEveryThird[b];  // bit 3 l: node a + 3 l
+              or_bits32(moved_row, a, at);
+              or_bits32(must, a - 2, at | at << 1 | at << 2 | at << 3 | at << 4);  // near_bits of each
+              row_lo = std::min(row_lo, a + 3 * static_cast<std::size_t>(std::countr_zero(b)));
+              row_hi = std::max(row_hi, a + 3 * static_cast<std::size_t>(31 - std::countl_zero(b)));
             }
             const std::size_t last = x_up ? a + 3 * (count - 1) : a;
             if (x_up ? last >= x1 : last <= x0) break;
@@ -639,6 +649,8 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
                        moved_bits.begin() + static_cast<std::ptrdiff_t>((a + 1) * words),
                        moved_bits.begin() + static_cast<std::ptrdiff_t>(b * words));
   active.assign_blocks(moved_bits, std::min(first, last), std::max(first, last));
+  moved = moved_sum;
+  report.transfers += transfer_count;
 }
 
 // Passes until `active` is empty or the budget is spent: ordered, live sweeps of the active

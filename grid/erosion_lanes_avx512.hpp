@@ -123,14 +123,14 @@ inline constexpr int kSlotColumn[8] = {2, 0, 1, 1, 2, 0, 2, 0};
 // once: the same as their erosion_visit calls one after the other, bit for bit (their blocks
 // are disjoint). The rounding carry (float) is settled lane by lane in visiting order
 // (`reverse`: the last lane first). Returns the lanes that transferred (bit l: node k + 3 l);
-// then given[l] is the volume lane l gave (m^3) and transfers[l] its receiving neighbours
-// (both unset when it returns 0).
+// then given[l] is the volume lane l gave (m^3) and `transfers` the receiving neighbours of
+// all lanes (both unset when it returns 0).
 template <int N, class Store, class Class>
 [[gnu::target("avx512f,avx512vl,avx512dq,avx512bw")]] unsigned erosion_visit8(Store& store, double fraction,
                                                                               std::size_t nx, std::size_t k,
                                                                               std::size_t lanes, const Class& c,
                                                                               bool reverse, double given_out[8],
-                                                                              std::int64_t transfers_out[8]) {
+                                                                              std::size_t& transfers_out) {
   auto* base = store.data() + k - 1;
   const auto w = static_cast<std::ptrdiff_t>(nx);
   const std::uint32_t window = (std::uint32_t{1} << (3 * lanes)) - 1;  // columns a - 1 .. a + 3 lanes - 2
@@ -162,7 +162,7 @@ template <int N, class Store, class Class>
   if (moving_bits == 0) return 0;
   const Double8 scale = fraction * largest / (moving ? sum : splat8(1.0));  // 0 where nothing moves
   Double8 given = splat8(0.0), error_m3 = splat8(0.0);
-  Mask8 transfers = {0, 0, 0, 0, 0, 0, 0, 0};
+  int transfers = 0;
   for (int s = 0; s < N; ++s) {
     const Double8 v = e[s] * scale;
     const Double8 z_new = zj[s] + v * c.inv_area[s];
@@ -174,7 +174,7 @@ template <int N, class Store, class Class>
       col[kSlotRow[s]][kSlotColumn[s]] = z_new;
     }
     given += v;
-    transfers -= e[s] > 0.0;  // lanes are 0 or -1
+    transfers += std::popcount(static_cast<unsigned>(greater(e[s], splat8(0.0))));
   }
   if constexpr (Store::kRounds) {
     double& carry = store.carry();
@@ -199,7 +199,7 @@ template <int N, class Store, class Class>
     store8(row + 16, m[2], merged[2]);
   }
   _mm512_storeu_pd(given_out, reinterpret_cast<__m512d>(given));
-  _mm512_storeu_si512(transfers_out, reinterpret_cast<__m512i>(transfers));
+  transfers_out = static_cast<std::size_t>(transfers);
   return moving_bits;
 }
 

@@ -2,6 +2,7 @@
 // Bit sets over one row of the grid, one bit per node (x at word x / 64, bit x % 64): the
 // dense pass's flags (nodes to visit) and its record of the nodes that transferred
 // (grid/erosion_kernel.hpp). Every function is O(1) or O(words of the range).
+#include <array>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -16,6 +17,20 @@ inline void or_bits(std::uint64_t* bits, std::size_t x, std::uint64_t m) {
   bits[x / 64] |= m << (x % 64);
   if (x % 64 > 56) bits[x / 64 + 1] |= m >> (64 - x % 64);
 }
+// Ors the low 32 bits of `m` in at bit x; writes the word after x's only where bits go there.
+inline void or_bits32(std::uint64_t* bits, std::size_t x, std::uint64_t m) {
+  bits[x / 64] |= m << (x % 64);
+  if (x % 64 > 32)
+    if (const std::uint64_t high = m >> (64 - x % 64)) bits[x / 64 + 1] |= high;
+}
+// Bit 3 l for each bit l of an 8-bit mask: lanes of a group of nodes three columns apart.
+inline constexpr std::array<std::uint32_t, 256> kEveryThird = [] {
+  std::array<std::uint32_t, 256> t{};
+  for (unsigned m = 0; m < 256; ++m)
+    for (unsigned l = 0; l < 8; ++l)
+      if ((m >> l) & 1) t[m] |= std::uint32_t{1} << (3 * l);
+  return t;
+}();
 // Sets bits [a, b].
 inline void set_bits(std::uint64_t* bits, std::size_t a, std::size_t b) {
   for (std::size_t w = a / 64; w <= b / 64; ++w) {
