@@ -67,6 +67,9 @@ template <class Real>
                                                                                                   Double8 b) {
   return _mm512_cmp_pd_mask(reinterpret_cast<__m512d>(a), reinterpret_cast<__m512d>(b), _CMP_GT_OQ);
 }
+[[gnu::target("avx512f,avx512vl,avx512dq,avx512bw"), gnu::always_inline]] inline Double8 min8(Double8 a, Double8 b) {
+  return a < b ? a : b;
+}
 [[gnu::target("avx512f,avx512vl,avx512dq,avx512bw"), gnu::always_inline]] inline Double8 splat8(double x) {
   return Double8{x, x, x, x, x, x, x, x};
 }
@@ -75,19 +78,38 @@ template <class Real>
 // transfer: unstable_bits (erosion_kernel.hpp) eight nodes per compare, the row's last
 // (x1 - x0 + 1) % 8 nodes in masked lanes. Same preconditions (interior nodes of an interior
 // row, bits of [x0, x1] clear; `out` holds the word after x1's); `c`: RowThresholds<N>.
+// Neighbours with the same thresholds (+-x; +-y; the diagonals) are tested at once on their
+// lowest height: (z_i - z_j) - crit is a non-increasing function of z_j in floating point too
+// (every rounding is monotone), so it exceeds the margin for some j exactly when it does for
+// the lowest -- the same bits as slot by slot, with 5 minima and 3 tests instead of 8 tests.
 template <int N, bool Gradient, class Real, class Thresholds>
 [[gnu::target("avx512f,avx512vl,avx512dq,avx512bw")]] void unstable_bits_avx512(const Real* z, std::size_t nx,
                                                                                 std::size_t x0, std::size_t x1,
                                                                                 const Thresholds& c,
                                                                                 std::uint64_t* out) {
   const auto w = static_cast<std::ptrdiff_t>(nx);
+  bool grouped = true;  // +-x, +-y and the diagonals each share their thresholds
+  for (const int s : {1, 3, 5, 6, 7})
+    if (s < N) grouped &= c.crit[s] == c.crit[s < 4 ? s - 1 : 4] && c.margin[s] == c.margin[s < 4 ? s - 1 : 4];
   for (std::size_t x = x0; x <= x1; x += 8) {
     const auto m = static_cast<__mmask8>((1u << std::min<std::size_t>(8, x1 + 1 - x)) - 1);
     const Real* p = z + x;
     const Double8 zi = load8(p, m);
     __mmask8 u = 0;
+    if (grouped) {
+      Double8 zj[N];
 #pragma GCC unroll 8
-    for (int s = 0; s < N; ++s) u |= greater(zi - load8(p + c.off[s], m) - c.crit[s], splat8(c.margin[s]));
+      for (int s = 0; s < N; ++s) zj[s] = load8(p + c.off[s], m);
+      const Double8 x_low = min8(zj[0], zj[1]), y_low = min8(zj[2], zj[3]);
+      u = greater(zi - x_low - c.crit[0], splat8(c.margin[0])) | greater(zi - y_low - c.crit[2], splat8(c.margin[2]));
+      if constexpr (N == 8) {
+        const Double8 d_low = min8(min8(zj[4], zj[5]), min8(zj[6], zj[7]));
+        u |= greater(zi - d_low - c.crit[4], splat8(c.margin[4]));
+      }
+    } else {
+#pragma GCC unroll 8
+      for (int s = 0; s < N; ++s) u |= greater(zi - load8(p + c.off[s], m) - c.crit[s], splat8(c.margin[s]));
+    }
     if constexpr (Gradient) {
       const Double8 gx = (load8(p + 1, m) - load8(p - 1, m)) * c.inv_run_x;
       const Double8 gy = (load8(p + w, m) - load8(p - w, m)) * c.inv_run_y;
@@ -142,15 +164,15 @@ template <int N, class Store, class Class>
     const Double8 raw[3] = {load8(row, m[0]), load8(row + 8, m[1]), load8(row + 16, m[2])};
     split3(raw, col[r]);
   }
-  const Mask8 lane_index = {0, 1, 2, 3, 4, 5, 6, 7};
-  const Mask8 live = lane_index < static_cast<std::int64_t>(lanes);
+  const auto live = static_cast<__mmask8>((1u << lanes) - 1);
   const Double8 zi = col[1][1];
   Double8 zj[N], e[N];
   Double8 sum = splat8(0.0), largest = splat8(0.0);
   for (int s = 0; s < N; ++s) {
     zj[s] = col[kSlotRow[s]][kSlotColumn[s]];
     const Double8 excess = zi - zj[s] - c.crit[s];
-    e[s] = reinterpret_cast<Double8>(reinterpret_cast<Mask8>(excess) & ((excess > c.margin[s]) & live));
+    const __mmask8 over = greater(excess, splat8(c.margin[s])) & live;
+    e[s] = reinterpret_cast<Double8>(_mm512_maskz_mov_pd(over, reinterpret_cast<__m512d>(excess)));  // else +0
   }
   for (int s = 0; s < N; ++s) {
     e[s] *= c.weight[s];
