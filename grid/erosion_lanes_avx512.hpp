@@ -179,10 +179,11 @@ template <int N, class Store, class Class>
     sum += e[s];
     largest = largest < e[s] ? e[s] : largest;
   }
-  const Mask8 moving = sum > 0.0;
-  const auto moving_bits = static_cast<unsigned>(_mm512_movepi64_mask(reinterpret_cast<__m512i>(moving)));
+  const __mmask8 moving = greater(sum, splat8(0.0));
+  const auto moving_bits = static_cast<unsigned>(moving);
   if (moving_bits == 0) return 0;
-  const Double8 scale = fraction * largest / (moving ? sum : splat8(1.0));  // 0 where nothing moves
+  const Double8 scale = reinterpret_cast<Double8>(_mm512_maskz_div_pd(
+      moving, reinterpret_cast<__m512d>(fraction * largest), reinterpret_cast<__m512d>(sum)));  // 0 where nothing moves
   Double8 given = splat8(0.0), error_m3 = splat8(0.0);
   int transfers = 0;
   for (int s = 0; s < N; ++s) {
