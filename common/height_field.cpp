@@ -47,6 +47,10 @@ HeightField HeightField::from_scene(const Scene& scene) {
   } else if (f.kind_ == TerrainKind::Plane) {
     const double a = deg_to_rad(scene.terrain.azimuth_deg);
     f.plane_gradient_ = -std::tan(deg_to_rad(scene.terrain.slope_deg)) * Vec2(std::cos(a), std::sin(a));
+  } else if (f.kind_ == TerrainKind::Cone) {
+    f.cone_tan_ = std::tan(deg_to_rad(scene.terrain.slope_deg));
+    f.cone_radius_m_ = cone_radius(scene.terrain.cone_volume_m3, f.cone_tan_);
+    f.feature_m_ = f.cone_radius_m_ / 8.0;
   } else if (f.kind_ == TerrainKind::Heightmap) {
     const Png16 png = read_png16(scene.terrain.heightmap_path, "terrain.path");
     f.img_w_ = png.width;
@@ -69,6 +73,9 @@ double HeightField::operator()(const Vec2& p) const {
       return base_m_;
     case TerrainKind::Plane:
       return base_m_ + plane_gradient_.dot(p - (domain_.origin_m + 0.5 * domain_.size_m));
+    case TerrainKind::Cone:
+      return base_m_ +
+             cone_tan_ * std::max(0.0, cone_radius_m_ - (p - (domain_.origin_m + 0.5 * domain_.size_m)).norm());
     case TerrainKind::Dunes: {
       double sum = 0.0;
       for (const Ridge& r : ridges_) {

@@ -1,13 +1,20 @@
 #pragma once
 // HeightField: the scene's initial surface as a function z(x, y) over the domain -- flat,
-// a tilted plane, seeded procedural dunes, or a 16-bit PNG heightmap stretched over the domain. Back-ends
+// a tilted plane, a sand cone, seeded procedural dunes, or a 16-bit PNG heightmap stretched over the domain. Back-ends
 // build their models from it; schedules use it for the tool depth. Evaluation is O(1).
+#include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <vector>
 
 #include "common/scene.hpp"
 
 namespace sb {
+
+// The base radius of a cone of `volume` (m^3) whose flank rises at tan_angle. O(1).
+inline double cone_radius(double volume, double tan_angle) {
+  return std::cbrt(3.0 * volume / (std::numbers::pi * tan_angle));
+}
 
 class HeightField {
  public:
@@ -17,7 +24,7 @@ class HeightField {
   double operator()(const Vec2& p) const;
   const DomainSpec& domain() const { return domain_; }
   // The smallest horizontal detail worth resolving: the heightmap pixel, a fraction of the
-  // shortest dune wavelength, or the domain for a flat terrain.
+  // shortest dune wavelength or of the cone's radius, or the domain for a flat terrain.
   double feature_m() const { return feature_m_; }
 
  private:
@@ -30,7 +37,8 @@ class HeightField {
   TerrainKind kind_ = TerrainKind::Flat;
   double base_m_ = 0.0;
   double amplitude_m_ = 0.0;
-  Vec2 plane_gradient_{0.0, 0.0};  // plane: dz/dx, dz/dy
+  Vec2 plane_gradient_{0.0, 0.0};                // plane: dz/dx, dz/dy
+  double cone_radius_m_ = 0.0, cone_tan_ = 0.0;  // cone: base radius, tan(flank slope)
   std::vector<Ridge> ridges_;
   double ridge_weight_sum_ = 1.0;
   std::size_t img_w_ = 0, img_h_ = 0;

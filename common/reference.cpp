@@ -10,7 +10,25 @@ namespace sb {
 
 namespace {
 
-double cone_radius(double volume, double tan_angle) { return std::cbrt(3.0 * volume / (std::numbers::pi * tan_angle)); }
+// The pile the pile reference expects: the sand poured, plus a cone terrain's own sand (which
+// stands on terrain.height_m around the domain's centre); the pour's centre otherwise.
+struct PileSetup {
+  double volume_m3 = 0.0;
+  Vec2 centre{0.0, 0.0};
+  bool on_cone = false;  // the base is terrain.height_m, not the initial surface
+};
+
+PileSetup pile_setup(const Scene& scene, const StampSchedule& schedule) {
+  PileSetup p;
+  for (const ToolStamp& s : schedule.stamps) p.volume_m3 += s.pour_volume_m3;
+  p.centre = schedule.stamps.front().pose.xy;
+  if (scene.terrain.kind == TerrainKind::Cone) {
+    p.volume_m3 += scene.terrain.cone_volume_m3;
+    p.centre = scene.domain.origin_m + 0.5 * scene.domain.size_m;
+    p.on_cone = true;
+  }
+  return p;
+}
 
 // Least-squares slope of y against x; 0 with fewer than two distinct x.
 double fitted_slope(const std::vector<double>& x, const std::vector<double>& y) {
@@ -76,15 +94,15 @@ std::optional<Raster> reference_raster(const Scene& scene, const StampSchedule& 
   const ToolStamp& first = schedule.stamps.front();
   switch (scene.reference) {
     case ReferenceKind::Pile: {
-      double volume = 0.0;
-      for (const ToolStamp& s : schedule.stamps) volume += s.pour_volume_m3;
+      const PileSetup pile = pile_setup(scene, schedule);
       const double t = scene.material.tan_critical();
-      const double radius = cone_radius(volume, t);
+      const double radius = cone_radius(pile.volume_m3, t);
       Raster r = lattice;
       for (std::size_t iy = 0; iy < r.ny; ++iy)
         for (std::size_t ix = 0; ix < r.nx; ++ix) {
           const Vec2 p = r.point(ix, iy);
-          r.at(ix, iy) = initial(p) + std::max(0.0, (radius - (p - first.pose.xy).norm()) * t);
+          const double base = pile.on_cone ? scene.terrain.height_m : initial(p);
+          r.at(ix, iy) = base + std::max(0.0, (radius - (p - pile.centre).norm()) * t);
         }
       return r;
     }
@@ -250,10 +268,10 @@ nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule&
   }
   const double crit = scene.material.critical_angle_deg;
   if (scene.reference == ReferenceKind::Pile) {
-    const Vec2 centre = schedule.stamps.front().pose.xy;
-    const PileShape p = measure_pile(final_raster, centre, initial(centre));
-    double volume = 0.0;
-    for (const ToolStamp& s : schedule.stamps) volume += s.pour_volume_m3;
+    const PileSetup pile = pile_setup(scene, schedule);
+    const PileShape p =
+        measure_pile(final_raster, pile.centre, pile.on_cone ? scene.terrain.height_m : initial(pile.centre));
+    const double volume = pile.volume_m3;
     j["pile.flank_angle_deg"] = p.flank_angle_deg;
     j["pile.flank_angle_error_deg"] = p.flank_angle_deg - crit;
     j["pile.roundness"] = p.roundness;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <numbers>
 #include <set>
 #include <sstream>
 
@@ -23,6 +24,8 @@ std::string to_string(TerrainKind k) {
       return "heightmap";
     case TerrainKind::Plane:
       return "plane";
+    case TerrainKind::Cone:
+      return "cone";
   }
   return "?";
 }
@@ -310,11 +313,12 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   const double extent = std::max(s.domain.size_m.x(), s.domain.size_m.y());
 
   // [terrain]
-  const std::string kind = f.choice("terrain.kind", "flat", {"flat", "dunes", "heightmap", "plane"});
+  const std::string kind = f.choice("terrain.kind", "flat", {"flat", "dunes", "heightmap", "plane", "cone"});
   s.terrain.kind = kind == "flat"        ? TerrainKind::Flat
                    : kind == "dunes"     ? TerrainKind::Dunes
                    : kind == "heightmap" ? TerrainKind::Heightmap
-                                         : TerrainKind::Plane;
+                   : kind == "plane"     ? TerrainKind::Plane
+                                         : TerrainKind::Cone;
   s.terrain.height_m = f.number("terrain.height_m", 0.1, open(-1e6, 1e6));
   if (s.terrain.kind == TerrainKind::Dunes) {
     s.terrain.dune_amplitude_m = f.number("terrain.amplitude_m", 0.02, closed(0.0, 1e3));
@@ -325,6 +329,13 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   if (s.terrain.kind == TerrainKind::Plane) {
     s.terrain.slope_deg = f.number("terrain.slope_deg", 0.0, closed(0.0, 89.0));
     s.terrain.azimuth_deg = f.number("terrain.azimuth_deg", 0.0, closed(-360.0, 360.0));
+  }
+  if (s.terrain.kind == TerrainKind::Cone) {
+    s.terrain.slope_deg = f.number("terrain.slope_deg", 35.0, closed(1.0, 89.0));
+    // At most the volume of a cone whose base is the domain's inscribed circle.
+    const double r = 0.5 * std::min(s.domain.size_m.x(), s.domain.size_m.y());
+    const double most = std::numbers::pi * r * r * r * std::tan(deg_to_rad(s.terrain.slope_deg)) / 3.0;
+    s.terrain.cone_volume_m3 = f.number("terrain.volume_m3", 2e-5, positive(most));
   }
   if (s.terrain.kind == TerrainKind::Heightmap) {
     std::filesystem::path p = f.string("terrain.path", /*required=*/true);
@@ -527,6 +538,7 @@ std::vector<SceneKey> scene_keys() {
       {"terrain.kind=dunes"},
       {"terrain.kind=heightmap", "terrain.path=\"terrain.png\""},
       {"terrain.kind=plane"},
+      {"terrain.kind=cone"},
       {"tool.shape=box", "tool.size_m=[0.04, 0.02]"},
       {"tool.shape=ellipse", "tool.size_m=[0.04, 0.02]"},
       {"tool.shape=polygon", "tool.polygon_m=[[0,0],[0.01,0],[0,0.01]]"},

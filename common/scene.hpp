@@ -15,7 +15,7 @@
 
 namespace sb {
 
-enum class TerrainKind { Flat, Dunes, Heightmap, Plane };
+enum class TerrainKind { Flat, Dunes, Heightmap, Plane, Cone };
 std::string to_string(TerrainKind k);
 
 struct DomainSpec {
@@ -39,6 +39,9 @@ struct TerrainSpec {
   // (counter-clockwise from +x); for the angle-of-repose experiments.
   double slope_deg = 0.0;
   double azimuth_deg = 0.0;
+  // cone: a sand cone of cone_volume_m3 standing at slope_deg on height_m, its apex at the
+  // domain's centre (a steep one relaxes to the pile reference with no pour dynamics).
+  double cone_volume_m3 = 0.0;
 };
 
 struct ErosionSpec {

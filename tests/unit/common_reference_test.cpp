@@ -208,5 +208,43 @@ raster_m = 0.0025
   EXPECT_GT(p.slope_max_deg, 35.0);
 }
 
+// A cone terrain standing at the critical angle is its own pile reference: its sand counts in
+// the reference's volume, its base is terrain.height_m (not the initial surface), and its
+// centre is the domain's, wherever the disturbance is poured.
+TEST(Reference, ConeTerrainAtCriticalIsThePileReference) {
+  const Scene s = parse_scene(R"(
+[domain]
+size_m = [0.3, 0.3]
+[terrain]
+kind = "cone"
+height_m = 0.05
+slope_deg = 30.0
+volume_m3 = 2e-5
+[tool]
+shape = "pour"
+radius_m = 0.004
+volume_m3 = 1e-12
+[stroke]
+path_m = [[0.16, 0.14]]
+[reference]
+kind = "pile"
+[output]
+raster_m = 0.001
+)",
+                              "cone");
+  const HeightField f = HeightField::from_scene(s);
+  const Raster cone = sampled(s.domain.box(), s.output.raster_m, [&](const Vec2& p) { return f(p); });
+  // Its volume above the base, by the raster (the cone's rim falls between samples).
+  double volume = 0.0;
+  for (double z : cone.values) volume += (z - 0.05) * cone.spacing_m * cone.spacing_m;
+  EXPECT_NEAR(volume, 2e-5, 2e-5 * 1e-3);
+  const auto m = accuracy_metrics(s, schedule_of(s, f), f, cone, cone);
+  EXPECT_LT(m["reference.rmse_m"].get<double>(), 1e-6);
+  EXPECT_NEAR(m["pile.radius_expected_m"].get<double>(), 0.03210, 1e-5);
+  EXPECT_NEAR(m["pile.height_m"].get<double>(), 0.03210 * std::tan(deg_to_rad(30.0)), 1e-4);
+  EXPECT_NEAR(m["pile.flank_angle_deg"].get<double>(), 30.0, 0.2);
+  EXPECT_LT(m["pile.roundness"].get<double>(), 0.01);
+}
+
 }  // namespace
 }  // namespace sb

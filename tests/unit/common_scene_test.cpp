@@ -38,7 +38,7 @@ TEST(Scene, MinimalSceneGetsDefaults) {
 }
 
 TEST(Scene, ShippedScenesLoad) {
-  for (const char* name : {"flat_stroke", "pile", "dunes"}) {
+  for (const char* name : {"flat_stroke", "pile", "dunes", "cone"}) {
     const auto path = std::filesystem::path(SB_SOURCE_DIR) / "experiments/scenes" / (std::string(name) + ".toml");
     EXPECT_NO_THROW(load_scene(path)) << name;
   }
@@ -71,46 +71,49 @@ TEST_P(SceneRejects, WithAMessageNamingTheField) {
   EXPECT_NE(msg.find(b.what), std::string::npos) << msg;
 }
 
-INSTANTIATE_TEST_SUITE_P(Fields, SceneRejects,
-                         ::testing::Values(
-                             // out of range
-                             BadField{{"tool.radius_m=-0.01"}, "tool.radius_m", "out of range"},
-                             BadField{{"tool.radius_m=0"}, "tool.radius_m", "(0,"},
-                             BadField{{"material.critical_angle_deg=90"}, "material.critical_angle_deg", "(0, 90)"},
-                             BadField{{"material.transfer_fraction=2.5"}, "material.transfer_fraction", "out of range"},
-                             BadField{{"grid.cell_m=-1"}, "grid.cell_m", "out of range"},
-                             BadField{{"grid.neighbours=6"}, "grid.neighbours", "4 or 8"},
-                             BadField{{"stroke.spacing_m=0"}, "stroke.spacing_m", "out of range"},
-                             BadField{{"stroke.repeat=0"}, "stroke.repeat", "out of range"},
-                             BadField{{"tin.alpha_flat_deg=50"}, "tin.alpha_flat_deg", "[0, 45]"},
-                             BadField{{"domain.size_m=[1.0, -1.0]"}, "domain.size_m[1]", "finite number in"},
-                             BadField{{"tool.sides=2"}, "tool.sides", "integer in [3, 4096]"},
-                             // NaN and infinity
-                             BadField{{"tool.radius_m=nan"}, "tool.radius_m", "finite"},
-                             BadField{{"terrain.height_m=inf"}, "terrain.height_m", "finite"},
-                             BadField{{"stroke.path_m=[[0.1, nan]]"}, "stroke.path_m[0]", "finite"},
-                             // wrong type
-                             BadField{{"tool.radius_m=\"big\""}, "tool.radius_m", "must be a number"},
-                             BadField{{"tool.shape=3"}, "tool.shape", "one of disk"},
-                             BadField{{"tool.shape=spoon"}, "tool.shape", "one of disk"},
-                             BadField{{"erosion.relax_at_end=1"}, "erosion.relax_at_end", "true or false"},
-                             BadField{{"grid.neighbours=8.5"}, "grid.neighbours", "integer"},
-                             BadField{{"stroke.path_m=[1, 2]"}, "stroke.path_m[0]", "[x, y]"},
-                             BadField{{"domain.size_m=[1.0]"}, "domain.size_m", "2 numbers"},
-                             // missing
-                             BadField{{"tool.shape=pour"}, "tool.volume_m3", "missing"},
-                             BadField{{"tool.shape=box"}, "tool.size_m", "missing"},
-                             BadField{{"terrain.kind=heightmap"}, "terrain.path", "missing"},
-                             // unknown keys and tables
-                             BadField{{"tool.radius=0.02"}, "tool.radius", "not a known key"},
-                             BadField{{"toool.radius_m=0.02"}, "toool.radius_m", "not a known key"},
-                             BadField{{"tin.cell_m=0.01"}, "tin.cell_m", "not a known key"},
-                             // inconsistent
-                             BadField{{"stroke.z_m=[0.1]"}, "stroke.z_m", "one per waypoint"},
-                             BadField{{"tool.shape=polygon", "tool.polygon_m=[[0,0],[1,1],[1,0],[0,1]]"},
-                                      "tool.polygon_m",
-                                      "simple polygon"},
-                             BadField{{"stroke.spacing_m=1e-9"}, "stroke.spacing_m", "1e7 stamps"}));
+INSTANTIATE_TEST_SUITE_P(
+    Fields, SceneRejects,
+    ::testing::Values(
+        // out of range
+        BadField{{"tool.radius_m=-0.01"}, "tool.radius_m", "out of range"},
+        BadField{{"tool.radius_m=0"}, "tool.radius_m", "(0,"},
+        BadField{{"material.critical_angle_deg=90"}, "material.critical_angle_deg", "(0, 90)"},
+        BadField{{"material.transfer_fraction=2.5"}, "material.transfer_fraction", "out of range"},
+        BadField{{"grid.cell_m=-1"}, "grid.cell_m", "out of range"},
+        BadField{{"grid.neighbours=6"}, "grid.neighbours", "4 or 8"},
+        BadField{{"stroke.spacing_m=0"}, "stroke.spacing_m", "out of range"},
+        BadField{{"stroke.repeat=0"}, "stroke.repeat", "out of range"},
+        BadField{{"tin.alpha_flat_deg=50"}, "tin.alpha_flat_deg", "[0, 45]"},
+        BadField{{"domain.size_m=[1.0, -1.0]"}, "domain.size_m[1]", "finite number in"},
+        BadField{{"tool.sides=2"}, "tool.sides", "integer in [3, 4096]"},
+        // a cone larger than the domain's inscribed circle can hold
+        BadField{{"terrain.kind=\"cone\"", "terrain.volume_m3=1"}, "terrain.volume_m3", "out of range"},
+        BadField{{"terrain.kind=\"cone\"", "terrain.slope_deg=90"}, "terrain.slope_deg", "[1, 89]"},
+        // NaN and infinity
+        BadField{{"tool.radius_m=nan"}, "tool.radius_m", "finite"},
+        BadField{{"terrain.height_m=inf"}, "terrain.height_m", "finite"},
+        BadField{{"stroke.path_m=[[0.1, nan]]"}, "stroke.path_m[0]", "finite"},
+        // wrong type
+        BadField{{"tool.radius_m=\"big\""}, "tool.radius_m", "must be a number"},
+        BadField{{"tool.shape=3"}, "tool.shape", "one of disk"},
+        BadField{{"tool.shape=spoon"}, "tool.shape", "one of disk"},
+        BadField{{"erosion.relax_at_end=1"}, "erosion.relax_at_end", "true or false"},
+        BadField{{"grid.neighbours=8.5"}, "grid.neighbours", "integer"},
+        BadField{{"stroke.path_m=[1, 2]"}, "stroke.path_m[0]", "[x, y]"},
+        BadField{{"domain.size_m=[1.0]"}, "domain.size_m", "2 numbers"},
+        // missing
+        BadField{{"tool.shape=pour"}, "tool.volume_m3", "missing"},
+        BadField{{"tool.shape=box"}, "tool.size_m", "missing"},
+        BadField{{"terrain.kind=heightmap"}, "terrain.path", "missing"},
+        // unknown keys and tables
+        BadField{{"tool.radius=0.02"}, "tool.radius", "not a known key"},
+        BadField{{"toool.radius_m=0.02"}, "toool.radius_m", "not a known key"},
+        BadField{{"tin.cell_m=0.01"}, "tin.cell_m", "not a known key"},
+        // inconsistent
+        BadField{{"stroke.z_m=[0.1]"}, "stroke.z_m", "one per waypoint"},
+        BadField{
+            {"tool.shape=polygon", "tool.polygon_m=[[0,0],[1,1],[1,0],[0,1]]"}, "tool.polygon_m", "simple polygon"},
+        BadField{{"stroke.spacing_m=1e-9"}, "stroke.spacing_m", "1e7 stamps"}));
 
 TEST(Scene, MissingRequiredFieldsAreNamed) {
   EXPECT_NE(error_of("[stroke]\npath_m = [[0.0, 0.0]]\n").find("domain.size_m is missing"), std::string::npos);
