@@ -43,9 +43,10 @@
 // the members fill at least an eighth of the spans: it first classes a row's nodes with
 // vector arithmetic (reads only) and visits only those that may transfer, in three phases
 // per row (the columns modulo 3: visits of a phase touch disjoint blocks, so they overlap in
-// the processor and run four at a time in AVX2 lanes), with no bookkeeping per visit (the
-// active set is rebuilt word by word after the pass). Both write in place, one node after
-// the other in a fixed order (four disjoint visits at once are the same as one after the
+// the processor and run up to eight at a time in AVX-512 lanes, erosion_lanes_avx512.hpp, or
+// four in AVX2 lanes, chosen at run time by what the CPU has), with no bookkeeping per visit
+// (the active set is rebuilt word by word after the pass). Both write in place, one node after
+// the other in a fixed order (disjoint visits at once are the same as one after the
 // other); the vector classing never writes, so both are Gauss-Seidel sweeps with the
 // conservation above and the energy argument below. They differ in which nodes they visit
 // (the dense pass also visits non-members in the spans; the active-set sweep revisits members
@@ -83,16 +84,16 @@
 //
 // Cost per visit: 9 height loads (4-neighbour: 5), ~6 floating-point operations per
 // neighbour, plus per transfer one division, and a store per receiving neighbour and one
-// for the centre (four visits in AVX2 lanes write every slot: no branch per slot); the
-// gradient rule adds a square root and a division per visit. Measured (tests/bench/grid_bench.cpp,
-// callgrind, edge rule, 8 neighbours), instructions per update (an update: one node of a
-// span or one active-set visit): 111 double / 150 float with every node of 2048^2 active
-// (before the three phases and the AVX2 lanes: 175 / 208), 222 / 281 on grid_bench's pile
-// (307 / 363), 160 / 213 on its stroke (243 / 289). Four visits in AVX2 lanes take ~320
-// instructions (double); classing a row ~16 per node (AVX2, double; ~29 float); rebuilding
-// the active set after a dense pass ~8 per node of the rows. Active-set visits add ~100 for
-// the set's bookkeeping. Float costs more than its instructions: the rounding carry chains
-// every transferring visit to the one before.
+// for the centre (visits in vector lanes write every slot: no branch per slot); the
+// gradient rule adds a square root and a division per visit. Measured with AVX-512 (Zen 4,
+// grid_bench, edge rule, 8 neighbours, CPU-time medians of runs interleaved with the AVX2
+// build): THROUGHPUT_AVX512. Measured in the AVX2 lanes (callgrind, which runs no AVX-512),
+// instructions per update (an update: one node of a span or one active-set visit): 111 double / 150 float with every
+// node of 2048^2 active (before the three phases and the AVX2 lanes: 175 / 208), 222 / 281 on grid_bench's pile (307 /
+// 363), 160 / 213 on its stroke (243 / 289). Four visits in AVX2 lanes take ~320 instructions (double); classing a row
+// ~16 per node (AVX2, double; ~29 float); rebuilding the active set after a dense pass ~8 per node of the rows.
+// Active-set visits add ~100 for the set's bookkeeping. Float costs more than its instructions: the rounding carry
+// chains every transferring visit to the one before.
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -291,7 +292,9 @@ template <class Real>
 // erosion_visit computes for its node, bit for bit (the same expressions, slot by slot in the
 // same order; AVX2 brings no FMA, so nothing is contracted). The rounding carry (float) is
 // settled lane by lane in visiting order (`reverse`: k + 9 first). Lanes that stay put write
-// their own heights back. Returns the lanes' results in lane order (k first).
+// their own heights back. Returns the lanes that transferred (bit l: node k + 3 l); then
+// given[l] is the volume lane l gave (m^3) and `transfers` the receiving neighbours of all
+// lanes (both unset when it returns 0), as erosion_visit8 does.
 // Heights p[0], p[3], p[6], p[9], widened to double.
 template <class Real>
 [[gnu::target("avx2"), gnu::always_inline]] inline Double4 every3(const Real* p) {
@@ -299,8 +302,8 @@ template <class Real>
                  static_cast<double>(p[9])};
 }
 template <int N, class Store>
-[[gnu::target("avx2")]] void erosion_visit4(Store& store, const ErosionTables& t, std::size_t k, const NodeClass& c,
-                                            bool reverse, VisitResult out[4]) {
+[[gnu::target("avx2")]] unsigned erosion_visit4(Store& store, const ErosionTables& t, std::size_t k, const NodeClass& c,
+                                                bool reverse, double given_out[4], std::size_t& transfers_out) {
   const auto* z = store.data() + k;
   const Double4 zi = every3(z);
   Double4 zj[N], e[N];
@@ -316,8 +319,8 @@ template <int N, class Store>
     largest = largest < e[s] ? e[s] : largest;
   }
   const Mask4 moving = sum > 0.0;
-  for (int l = 0; l < 4; ++l) out[l] = {};
-  if (_mm256_movemask_pd(reinterpret_cast<__m256d>(moving)) == 0) return;
+  const auto moving_bits = static_cast<unsigned>(_mm256_movemask_pd(reinterpret_cast<__m256d>(moving)));
+  if (moving_bits == 0) return 0;
   const Double4 one = {1.0, 1.0, 1.0, 1.0};
   const Double4 scale = t.fraction() * largest / (moving ? sum : one);  // 0 where nothing moves
   Double4 given = {0.0, 0.0, 0.0, 0.0}, error_m3 = {0.0, 0.0, 0.0, 0.0};
@@ -351,7 +354,9 @@ template <int N, class Store>
     const Double4 z_centre = zi - given * c.inv_area_i;
     for (int l = 0; l < 4; ++l) store.put(k + static_cast<std::size_t>(3 * l), z_centre[l]);
   }
-  for (int l = 0; l < 4; ++l) out[l] = {static_cast<int>(transfers[l]), given[l]};
+  std::memcpy(given_out, &given, sizeof given);
+  transfers_out = static_cast<std::size_t>(transfers[0] + transfers[1] + transfers[2] + transfers[3]);
+  return moving_bits;
 }
 
 // Which sweep erode_ordered runs (tests force one; Auto is what the terrains use). Dense
@@ -478,22 +483,24 @@ inline Lanes lanes_for(SweepPath path) {
 // Order within a row: three phases, the columns x = r (mod 3) for each r in turn, each phase
 // in the sweep's x direction. Nodes three columns apart have disjoint 3 x 3 blocks, so the
 // visits of a phase do not depend on one another: the processor overlaps them, and on a
-// contiguous store with AVX2 four of them (k, k + 3, k + 6, k + 9) run at once, one per lane
-// (erosion_visit4, bit for bit four erosion_visit calls). It is still one visit after the
+// contiguous store up to eight of them (k, k + 3, ..., k + 21; erosion_visit8, AVX-512, masked
+// lanes where the span's interior ends) or four (erosion_visit4, AVX2) run at once, one per
+// lane, bit for bit those erosion_visit calls. It is still one visit after the
 // other (Gauss-Seidel, the energy argument above), in a different order from a plain row
 // sweep: an avalanche along x moves up to three nodes per pass in a row instead of the whole
 // run (along y, rows still follow each other). The order depends only on the active set, so
 // every store computes the same heights.
 //
 // Exactness of the shortcut. On a store with contiguous heights (HeightGrid: data()), a
-// row's interior nodes are first classed by unstable_bits (AVX2: four at a time), after the
+// row's interior nodes are first classed by unstable_bits (AVX-512: eight at a time; AVX2:
+// four), after the
 // previous row is done; a node is then visited only if it is flagged, on a border, or within
 // two columns of a node of its row that transferred before it (a visit writes into its 3 x 3
 // block, which a node up to two columns away reads). Its inputs are otherwise those it was
 // classed with, so skipping it is exactly what its visit would have done: the pass gives the
 // same heights, bit for bit, as visiting every node of the spans (which is what it does on
-// other stores, e.g. the sparse grid). `wide` = false classes in SSE2 registers and visits
-// one node at a time (the same heights; tests compare).
+// other stores, e.g. the sparse grid). `lanes` = Sse2 classes in SSE2 registers and visits
+// one node at a time, Avx2 four at a time (the same heights; tests compare).
 //
 // Cost: O(span nodes) per pass -- the classing vectorised over the row, one visit per
 // unstable node -- plus O(words of the visited rows) to find the spans and update the set.
@@ -569,6 +576,21 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       row_hi = std::max(row_hi, ix);
       near_bits(must, ix);
     };
+    // The same for the nodes a + 3 l of a group whose lanes l (bits of b) transferred, at once
+    // (volumes added in visiting order).
+    const auto group_transferred = [&](std::size_t a, unsigned b, const double* given, std::size_t transfers) {
+      for (unsigned rest = b; rest != 0;) {
+        const int l = x_up ? std::countr_zero(rest) : 31 - std::countl_zero(rest);
+        rest &= ~(1u << l);
+        moved_sum += given[l];
+      }
+      transfer_count += transfers;
+      const std::uint64_t at = kEveryThird[b];  // bit 3 l: node a + 3 l
+      or_bits32(moved_row, a, at);
+      or_bits32(must, a - 2, at | at << 1 | at << 2 | at << 3 | at << 4);  // near_bits of each
+      row_lo = std::min(row_lo, a + 3 * static_cast<std::size_t>(std::countr_zero(b)));
+      row_hi = std::max(row_hi, a + 3 * static_cast<std::size_t>(31 - std::countl_zero(b)));
+    };
     const auto visit = [&](std::size_t ix) __attribute__((flatten)) {  // the store's reads and writes inlined
       const VisitResult v =
           erosion_visit<N, Gradient>(store, t, iy * nx + ix, ix < 2 || ix + 2 >= nx ? t.of(ix, iy) : middle);
@@ -595,32 +617,18 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
             double given[8];
             std::size_t transfers = 0;
             if (const unsigned b =
-                    erosion_visit8<N>(store, t.fraction(), nx, iy * nx + a, count, middle, !x_up, given, transfers)) {
-              // What transferred() does per node, for the group at once (volumes in visiting order).
-              for (unsigned rest = b; rest != 0;) {
-                const int l = x_up ? std::countr_zero(rest) : 31 - std::countl_zero(rest);
-                rest &= ~(1u << l);
-                moved_sum += given[l];
-              }
-              transfer_count += transfers;
-              const std::uint64_t at = kEveryThird[b];  // bit 3 l: node a + 3 l
-              or_bits32(moved_row, a, at);
-              or_bits32(must, a - 2, at | at << 1 | at << 2 | at << 3 | at << 4);  // near_bits of each
-              row_lo = std::min(row_lo, a + 3 * static_cast<std::size_t>(std::countr_zero(b)));
-              row_hi = std::max(row_hi, a + 3 * static_cast<std::size_t>(31 - std::countl_zero(b)));
-            }
+                    erosion_visit8<N>(store, t.fraction(), nx, iy * nx + a, count, middle, !x_up, given, transfers))
+              group_transferred(a, b, given, transfers);
             const std::size_t last = x_up ? a + 3 * (count - 1) : a;
             if (x_up ? last >= x1 : last <= x0) break;
             from = x_up ? last + 1 : last - 1;
             continue;
           }
           if (in_groups && lanes == Lanes::Avx2 && lowest >= four_lo && lowest + 9 <= four_hi) {
-            VisitResult v[4];
-            erosion_visit4<N>(store, t, iy * nx + lowest, middle, !x_up, v);
-            for (int i = 0; i < 4; ++i) {
-              const int l = x_up ? i : 3 - i;
-              if (v[l].transfers > 0) transferred(lowest + 3 * static_cast<std::size_t>(l), v[l]);
-            }
+            double given[4];
+            std::size_t transfers = 0;
+            if (const unsigned b = erosion_visit4<N>(store, t, iy * nx + lowest, middle, !x_up, given, transfers))
+              group_transferred(lowest, b, given, transfers);
             const std::size_t last = x_up ? lowest + 9 : lowest;
             if (x_up ? last >= x1 : last <= x0) break;
             from = x_up ? last + 1 : last - 1;
