@@ -86,14 +86,19 @@
 // neighbour, plus per transfer one division, and a store per receiving neighbour and one
 // for the centre (visits in vector lanes write every slot: no branch per slot); the
 // gradient rule adds a square root and a division per visit. Measured with AVX-512 (Zen 4,
-// grid_bench, edge rule, 8 neighbours, CPU-time medians of runs interleaved with the AVX2
-// build): THROUGHPUT_AVX512. Measured in the AVX2 lanes (callgrind, which runs no AVX-512),
-// instructions per update (an update: one node of a span or one active-set visit): 111 double / 150 float with every
-// node of 2048^2 active (before the three phases and the AVX2 lanes: 175 / 208), 222 / 281 on grid_bench's pile (307 /
-// 363), 160 / 213 on its stroke (243 / 289). Four visits in AVX2 lanes take ~320 instructions (double); classing a row
-// ~16 per node (AVX2, double; ~29 float); rebuilding the active set after a dense pass ~8 per node of the rows.
-// Active-set visits add ~100 for the set's bookkeeping. Float costs more than its instructions: the rounding carry
-// chains every transferring visit to the one before.
+// tests/bench/grid_bench.cpp, edge rule, 8 neighbours, CPU time, medians of three runs
+// interleaved with the build before the AVX-512 lanes), M updates/s (an update: one node of
+// a span or one active-set visit): double 79 on the pile (before: 64), 121 on the stroke
+// (81), 155 with every node of 2048^2 active (104; 10.5x the plain scalar sweep in the same
+// runs, before 7.5x); float 40 (40), 58 (47), 86 (71). Measured in the AVX2 lanes
+// (callgrind, which runs no AVX-512), instructions per update, double / float, now (before
+// the group bookkeeping; before the three phases and the AVX2 lanes): every node of 2048^2
+// active 107 double (111 / 150; 175 / 208), grid_bench's pile 212 / 271 (222 / 281; 307 /
+// 363), its stroke 150 / 203 (160 / 213; 243 / 289). Four visits in AVX2 lanes take ~320 instructions
+// (double); classing a row ~16 per node (AVX2, double; ~29 float); rebuilding the active set
+// after a dense pass ~8 per node of the rows. Active-set visits add ~100 for the set's
+// bookkeeping. Float costs more than its instructions: the rounding carry chains every
+// transferring visit to the one before (float gains least from the wider lanes).
 #include <algorithm>
 #include <array>
 #include <bit>
