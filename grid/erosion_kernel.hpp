@@ -603,7 +603,9 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     };
     // Three phases, one per column modulo 3, each in the sweep's direction; on a contiguous
     // store, four nodes of a phase at once where they are interior nodes of the span.
-    const bool in_groups = lanes != Lanes::Sse2 && !Gradient && skip_lo <= skip_hi && nx >= 13;
+    // (the gradient rule in AVX-512 lanes only)
+    const bool in_groups =
+        (lanes == Lanes::Avx512 || (lanes == Lanes::Avx2 && !Gradient)) && skip_lo <= skip_hi && nx >= 13;
     const std::size_t four_lo = std::max<std::size_t>(x0, 2), four_hi = std::min(x1, nx - 3);
     for (std::size_t p = 0; p < 3; ++p) {
       const std::size_t r = x_up ? (x0 + p) % 3 : (x1 + 3 - p) % 3;
@@ -622,7 +624,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
             double given[8];
             std::size_t transfers = 0;
             if (const unsigned b =
-                    erosion_visit8<N>(store, t.fraction(), nx, iy * nx + a, count, middle, !x_up, given, transfers))
+                    erosion_visit8<N, Gradient>(store, t, nx, iy * nx + a, count, middle, !x_up, given, transfers))
               group_transferred(a, b, given, transfers);
             const std::size_t last = x_up ? a + 3 * (count - 1) : a;
             if (x_up ? last >= x1 : last <= x0) break;

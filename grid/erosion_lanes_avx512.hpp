@@ -149,9 +149,10 @@ inline constexpr int kSlotColumn[8] = {2, 0, 1, 1, 2, 0, 2, 0};
 // are disjoint). The rounding carry (float) is settled lane by lane in visiting order
 // (`reverse`: the last lane first). Returns the lanes that transferred (bit l: node k + 3 l);
 // then given[l] is the volume lane l gave (m^3) and `transfers` the receiving neighbours of
-// all lanes (both unset when it returns 0).
-template <int N, class Store, class Class>
-[[gnu::target("avx512f,avx512vl,avx512dq,avx512bw")]] unsigned erosion_visit8(Store& store, double fraction,
+// all lanes (both unset when it returns 0). Gradient: the gradient rule (central differences,
+// the interior class's), as erosion_visit<N, true>; `t`: the ErosionTables.
+template <int N, bool Gradient, class Store, class Class, class Tables>
+[[gnu::target("avx512f,avx512vl,avx512dq,avx512bw")]] unsigned erosion_visit8(Store& store, const Tables& t,
                                                                               std::size_t nx, std::size_t k,
                                                                               std::size_t lanes, const Class& c,
                                                                               bool reverse, double given_out[8],
@@ -177,6 +178,26 @@ template <int N, class Store, class Class>
     const __mmask8 over = greater(excess, splat8(c.margin[s])) & live;
     e[s] = reinterpret_cast<Double8>(_mm512_maskz_mov_pd(over, reinterpret_cast<__m512d>(excess)));  // else +0
   }
+  if constexpr (Gradient) {  // erosion_visit's expressions, lane by lane; lanes not steep keep e
+    const Double8 gx = (col[1][2] - col[1][0]) * c.inv_run_x;
+    const Double8 gy = (col[2][1] - col[0][1]) * c.inv_run_y;
+    const Double8 g2 = gx * gx + gy * gy;
+    const __mmask8 steep = greater(g2, splat8(t.tan_settle() * t.tan_settle())) & live;
+    if (steep != 0) {
+      const Double8 steepness = reinterpret_cast<Double8>(  // 1 where not steep (unused)
+          _mm512_mask_sqrt_pd(reinterpret_cast<__m512d>(splat8(1.0)), steep, reinterpret_cast<__m512d>(g2)));
+      const Double8 ux = -gx / steepness, uy = -gy / steepness;  // downhill unit vector (steep lanes)
+      for (int s = 0; s < N; ++s) {
+        const Double8 run = c.ox[s] * ux + c.oy[s] * uy;
+        const Double8 drop = zi - zj[s], cap = steepness * run;
+        const Double8 along = (cap < drop ? cap : drop) - run * t.tan_critical();  // std::min(drop, cap)
+        const __mmask8 takes = steep & greater(run, splat8(0.0)) & greater(along, splat8(c.margin[s]));
+        const Double8 raised = e[s] < along ? along : e[s];  // std::max(e, along)
+        e[s] = reinterpret_cast<Double8>(
+            _mm512_mask_mov_pd(reinterpret_cast<__m512d>(e[s]), takes, reinterpret_cast<__m512d>(raised)));
+      }
+    }
+  }
   for (int s = 0; s < N; ++s) {
     e[s] *= c.weight[s];
     sum += e[s];
@@ -185,8 +206,9 @@ template <int N, class Store, class Class>
   const __mmask8 moving = greater(sum, splat8(0.0));
   const auto moving_bits = static_cast<unsigned>(moving);
   if (moving_bits == 0) return 0;
-  const Double8 scale = reinterpret_cast<Double8>(_mm512_maskz_div_pd(
-      moving, reinterpret_cast<__m512d>(fraction * largest), reinterpret_cast<__m512d>(sum)));  // 0 where nothing moves
+  const Double8 scale =
+      reinterpret_cast<Double8>(_mm512_maskz_div_pd(moving, reinterpret_cast<__m512d>(t.fraction() * largest),
+                                                    reinterpret_cast<__m512d>(sum)));  // 0 where nothing moves
   Double8 given = splat8(0.0), error_m3 = splat8(0.0);
   int transfers = 0;
   for (int s = 0; s < N; ++s) {

@@ -2,7 +2,7 @@
 // three columns apart visited at once (erosion_visit8) leaves the grid, the rounding carry,
 // the transfer count and the volumes given bit for bit as the same nodes' scalar visits
 // (erosion_visit) one after the other, forwards and backwards, float and double, 4 and 8
-// neighbours, on rough states where most nodes transfer; and dense passes take those lanes
+// neighbours, edge and gradient rules, on rough states where most nodes transfer; and dense passes take those lanes
 // where the CPU has them. Skipped (GTEST_SKIP, saying so) on CPUs without AVX-512; the AVX2
 // and SSE2 paths are compared with each other and with the sparse grid in
 // grid_dense_pass_test.cpp.
@@ -33,10 +33,11 @@ bool same_bits(const HeightGrid<Real>& a, const HeightGrid<Real>& b) {
   return std::memcmp(a.heights().data(), b.heights().data(), a.heights().size() * sizeof(Real)) == 0;
 }
 
-template <class Real, int N>
+template <class Real, int N, bool Gradient = false>
 void groups_are_scalar_visits() {
   if (!has_avx512()) GTEST_SKIP() << "this CPU has no AVX-512: the eight-lane visits are not exercised here";
-  const ErosionTables tables(kLayout, N, test::rule_for(ErosionRuleKind::Edge), false);
+  const ErosionTables tables(kLayout, N, test::rule_for(Gradient ? ErosionRuleKind::Gradient : ErosionRuleKind::Edge),
+                             Gradient);
   const std::size_t nx = kLayout.nx;
   int groups = 0, moving_groups = 0;
   for (std::uint64_t seed = 1; seed <= 4; ++seed)
@@ -50,12 +51,12 @@ void groups_are_scalar_visits() {
             double given[8];
             std::size_t transfers = 0;
             const unsigned moved =
-                erosion_visit8<N>(lanes, tables.fraction(), nx, iy * nx + a, count, c, reverse, given, transfers);
+                erosion_visit8<N, Gradient>(lanes, tables, nx, iy * nx + a, count, c, reverse, given, transfers);
             unsigned expected = 0;
             std::size_t expected_transfers = 0;
             for (std::size_t i = 0; i < count; ++i) {
               const std::size_t l = reverse ? count - 1 - i : i;
-              const VisitResult v = erosion_visit<N, false>(scalar, tables, iy * nx + a + 3 * l, c);
+              const VisitResult v = erosion_visit<N, Gradient>(scalar, tables, iy * nx + a + 3 * l, c);
               if (v.transfers == 0) continue;
               expected |= 1u << l;
               expected_transfers += static_cast<std::size_t>(v.transfers);
@@ -79,6 +80,9 @@ TEST(EightLaneVisit, IsTheScalarVisitsBitForBitDoubleEight) { groups_are_scalar_
 TEST(EightLaneVisit, IsTheScalarVisitsBitForBitDoubleFour) { groups_are_scalar_visits<double, 4>(); }
 TEST(EightLaneVisit, IsTheScalarVisitsBitForBitFloatEight) { groups_are_scalar_visits<float, 8>(); }
 TEST(EightLaneVisit, IsTheScalarVisitsBitForBitFloatFour) { groups_are_scalar_visits<float, 4>(); }
+TEST(EightLaneVisit, IsTheScalarVisitsBitForBitGradientDoubleEight) { groups_are_scalar_visits<double, 8, true>(); }
+TEST(EightLaneVisit, IsTheScalarVisitsBitForBitGradientDoubleFour) { groups_are_scalar_visits<double, 4, true>(); }
+TEST(EightLaneVisit, IsTheScalarVisitsBitForBitGradientFloatEight) { groups_are_scalar_visits<float, 8, true>(); }
 
 // Dense passes take the widest lanes the CPU has, DenseAvx2 and DenseBaseline narrower ones.
 TEST(DenseLanes, WidestTheCpuHas) {
