@@ -90,7 +90,9 @@
 // interleaved with the build before the AVX-512 lanes), M updates/s (an update: one node of
 // a span or one active-set visit): double 79 on the pile (before: 64), 121 on the stroke
 // (81), 155 with every node of 2048^2 active (104; 10.5x the plain scalar sweep in the same
-// runs, before 7.5x); float 40 (40), 58 (47), 86 (71). Measured in the AVX2 lanes
+// runs, before 7.5x); float 40 (40), 58 (47), 86 (71); the gradient rule (AVX-512 lanes
+// only; AVX2 visits it one node at a time), double: 54 on the pile and 79 on the stroke
+// (one node at a time: 21 and 24). Measured in the AVX2 lanes
 // (callgrind, which runs no AVX-512), instructions per update, double / float, now (before
 // the group bookkeeping; before the three phases and the AVX2 lanes): every node of 2048^2
 // active 107 double (111 / 150; 175 / 208), grid_bench's pile 212 / 271 (222 / 281; 307 /
