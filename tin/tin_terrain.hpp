@@ -47,15 +47,15 @@
 // local face traversal per split and per removal.
 // Point location walks from the last located face; its guard uses the data structure's O(1)
 // face count (CGAL's number_of_faces() circulates the hull: O(sqrt(n)) with border points).
-// Stale constraints (of stamps before the current one) are dropped at each stamp. A tool
-// deeper than the bed stops at z = 0. Erosion re-activates the giver's neighbours and the
-// receivers; under the gradient rule also the receivers' neighbours, whose fan gradients read
-// the receiver's height (one ring there, measured: 7 % fewer visits on trench.toml, but the
-// pile's flank settles 0.7 degrees further from critical); tan_settle is its settling
-// criterion. A stamp
-// re-activates the vertices whose heights it changed with their neighbours, and of the rest
-// of the retriangulated region only vertices next to a face steeper than critical.
-// Not thread-safe: height() and sample() move the walk hint.
+// Stale constraints (of stamps before the current one) are dropped at each stamp, and with
+// tin.conserve_volume the top of each pair of their contour vertices closer than refine_m / 3
+// goes (O and I lie a contour gap apart, far below the mesh's resolution, and two such small
+// areas throttled every transfer across the old wall). A tool deeper than the bed stops at z = 0. Erosion re-activates
+// the giver's neighbours and the receivers; under the gradient rule also the receivers' neighbours, whose fan gradients
+// read the receiver's height (one ring there, measured: 7 % fewer visits on trench.toml, but the pile's flank settles
+// 0.7 degrees further from critical); tan_settle is its settling criterion. A stamp re-activates the vertices whose
+// heights it changed with their neighbours, and of the rest of the retriangulated region only vertices next to a face
+// steeper than critical. Not thread-safe: height() and sample() move the walk hint.
 #include <memory>
 #include <vector>
 

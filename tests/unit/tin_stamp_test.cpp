@@ -180,6 +180,43 @@ TEST(TinStamp, OldGenerationsAreDroppedOnceTheStampHasPassed) {
   EXPECT_NEAR(t->volume(), 0.025, 1e-12);
 }
 
+TEST(TinStamp, APassedStampLeavesNoWallThinnerThanTheMeshResolves) {
+  // O and I lie a contour gap (1 mm) apart, a tenth of the mesh's edges (tin.refine_m): once
+  // the stamp has passed, the top of each such pair goes (under tin.conserve_volume, which
+  // gives the change back), so no two of its contour vertices are closer than a third of it.
+  for (bool conserve : {true, false}) {
+    const Scene s = scene(kFlatScene, {kSixteenSides, "tin.refine_m=0.01",
+                                       std::string("tin.conserve_volume=") + (conserve ? "true" : "false")});
+    auto t = make(s);
+    const double v0 = t->volume();
+    const Vec2 centre(0.25, 0.25);
+    // Edges shorter than refine_m / 3 across the old wall (the footprint's radius is 2 cm).
+    const auto thin_wall_edges = [&] {
+      const SurfaceMesh m = t->mesh();
+      std::size_t n = 0;
+      for (const auto& f : m.triangles) {
+        for (int k = 0; k < 3; ++k) {
+          const Vec2 a = m.vertices[f[k]].head<2>(), b = m.vertices[f[(k + 1) % 3]].head<2>();
+          const double r = (0.5 * (a + b) - centre).norm();
+          if ((a - b).norm() < 0.01 / 3.0 && r > 0.017 && r < 0.024) ++n;
+        }
+      }
+      return n / 2;  // each interior edge is seen from both of its triangles
+    };
+    t->stamp(stamp_at(s, centre, -1.0, {1, 0}, 0));  // deeper than the bed: a 10 cm wall
+    const std::size_t before = thin_wall_edges();
+    EXPECT_GE(before, 16u) << "O and I pairs, one per corner of the 16-gon";
+    t->stamp(stamp_at(s, {0.1, 0.1}, 0.09, {1, 0}, 1));  // far away: the first has passed
+    SB_EXPECT_TIN_OK(*t);
+    if (conserve) {
+      EXPECT_EQ(thin_wall_edges(), 0u);
+      EXPECT_NEAR(t->volume(), v0, 1e-12 * v0);
+    } else {
+      EXPECT_EQ(thin_wall_edges(), before) << "without the give-back the surface is left as it is";
+    }
+  }
+}
+
 TEST(TinStamp, RemovesRedundantInnerVertices) {
   const Scene s = scene(kFlatScene, {kSixteenSides});
   auto t = make(s);

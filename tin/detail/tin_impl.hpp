@@ -240,10 +240,15 @@ class TinTerrain final : public Terrain {
   // edge of v's star is, nor the star's mean gradient, so erosion has nothing to move at v.
   bool next_to_steep_face(VertexHandle v) const;
   StampReport pour(const ToolStamp& s);
-  // Unconstrains every edge of a generation older than `generation` and returns the volume
-  // change of the flips (the stamp's deposit gives it back), with the vertices of the faces
-  // they changed; O(constrained edges + region).
+  // Unconstrains every edge of a generation older than `generation`, thins the passed
+  // contours (tin.conserve_volume), and returns the volume change of the flips and removals
+  // (the stamp's deposit gives it back), with the vertices of the faces they changed;
+  // O(constrained edges + region).
   double drop_stale_constraints(std::uint32_t generation, std::vector<VertexHandle>& region_vertices);
+  // Of the contour vertices of passed stamps (the ends of their `stale` constraints, all
+  // unconstrained now), those with a lower one among them closer than a third of refine_m_
+  // removed: the top of the wall between O and I. O(ends x degree) plus the removals.
+  void thin_passed_contours(const std::vector<std::pair<VertexHandle, VertexHandle>>& stale);
   // Raises the vertices by one dz that adds `volume` (a stamp off the domain gives the flips'
   // change back so). O(vertices x degree).
   void spread_volume(const std::vector<VertexHandle>& vertices, double volume);
@@ -257,7 +262,9 @@ class TinTerrain final : public Terrain {
   // v's neighbours (vertex_scratch_) with heights, distances and areas (nbr_scratch_); returns
   // v's area.
   double gather_neighbours(VertexHandle v);
-  // Splits v's edges longer than refine_m_ until none is; returns the number of splits.
+  // Splits v's edges longer than refine_m_ until none is left that may be split (a constrained
+  // edge only where its middle is exactly on it, no edge whose middle a facing vertex crowds);
+  // returns the number of splits.
   std::size_t refine_around(VertexHandle v);
   // Curvature refinement: splits v's longest edge longer than fine_m_ that sand crosses (a
   // transfer in transfer_scratch_) and across which the gradients of its two facets jump by
