@@ -43,9 +43,10 @@
 // the members fill at least an eighth of the spans: it first classes a row's nodes with
 // vector arithmetic (reads only) and visits only those that may transfer, in three phases
 // per row (the columns modulo 3: visits of a phase touch disjoint blocks, so they overlap in
-// the processor and run four at a time in AVX2 lanes), with no bookkeeping per visit (the
-// active set is rebuilt word by word after the pass). Both write in place, one node after
-// the other in a fixed order (four disjoint visits at once are the same as one after the
+// the processor and run up to eight at a time in AVX-512 lanes, erosion_lanes_avx512.hpp, or
+// four in AVX2 lanes, chosen at run time by what the CPU has), with no bookkeeping per visit
+// (the active set is rebuilt word by word after the pass). Both write in place, one node after
+// the other in a fixed order (disjoint visits at once are the same as one after the
 // other); the vector classing never writes, so both are Gauss-Seidel sweeps with the
 // conservation above and the energy argument below. They differ in which nodes they visit
 // (the dense pass also visits non-members in the spans; the active-set sweep revisits members
@@ -83,16 +84,23 @@
 //
 // Cost per visit: 9 height loads (4-neighbour: 5), ~6 floating-point operations per
 // neighbour, plus per transfer one division, and a store per receiving neighbour and one
-// for the centre (four visits in AVX2 lanes write every slot: no branch per slot); the
-// gradient rule adds a square root and a division per visit. Measured (tests/bench/grid_bench.cpp,
-// callgrind, edge rule, 8 neighbours), instructions per update (an update: one node of a
-// span or one active-set visit): 111 double / 150 float with every node of 2048^2 active
-// (before the three phases and the AVX2 lanes: 175 / 208), 222 / 281 on grid_bench's pile
-// (307 / 363), 160 / 213 on its stroke (243 / 289). Four visits in AVX2 lanes take ~320
-// instructions (double); classing a row ~16 per node (AVX2, double; ~29 float); rebuilding
-// the active set after a dense pass ~8 per node of the rows. Active-set visits add ~100 for
-// the set's bookkeeping. Float costs more than its instructions: the rounding carry chains
-// every transferring visit to the one before.
+// for the centre (visits in vector lanes write every slot: no branch per slot); the
+// gradient rule adds a square root and a division per visit. Measured with AVX-512 (Zen 4,
+// tests/bench/grid_bench.cpp, edge rule, 8 neighbours, CPU time, medians of three runs
+// interleaved with the build before the AVX-512 lanes), M updates/s (an update: one node of
+// a span or one active-set visit): double 79 on the pile (before: 64), 121 on the stroke
+// (81), 155 with every node of 2048^2 active (104; 10.5x the plain scalar sweep in the same
+// runs, before 7.5x); float 40 (40), 58 (47), 86 (71); the gradient rule (AVX-512 lanes
+// only; AVX2 visits it one node at a time), double: 54 on the pile and 79 on the stroke
+// (one node at a time: 21 and 24). Measured in the AVX2 lanes
+// (callgrind, which runs no AVX-512), instructions per update, double / float, now (before
+// the group bookkeeping; before the three phases and the AVX2 lanes): every node of 2048^2
+// active 107 double (111 / 150; 175 / 208), grid_bench's pile 212 / 271 (222 / 281; 307 /
+// 363), its stroke 150 / 203 (160 / 213; 243 / 289). Four visits in AVX2 lanes take ~320 instructions
+// (double); classing a row ~16 per node (AVX2, double; ~29 float); rebuilding the active set
+// after a dense pass ~8 per node of the rows. Active-set visits add ~100 for the set's
+// bookkeeping. Float costs more than its instructions: the rounding carry chains every
+// transferring visit to the one before (float gains least from the wider lanes).
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -106,7 +114,9 @@
 
 #include "common/erosion.hpp"
 #include "common/terrain.hpp"
+#include "grid/erosion_lanes_avx512.hpp"
 #include "grid/grid_layout.hpp"
+#include "grid/row_bits.hpp"
 
 // _mm256_movemask_pd, in the AVX2 functions only (compiled for AVX2 by their target attribute).
 #include <immintrin.h>
@@ -289,7 +299,9 @@ template <class Real>
 // erosion_visit computes for its node, bit for bit (the same expressions, slot by slot in the
 // same order; AVX2 brings no FMA, so nothing is contracted). The rounding carry (float) is
 // settled lane by lane in visiting order (`reverse`: k + 9 first). Lanes that stay put write
-// their own heights back. Returns the lanes' results in lane order (k first).
+// their own heights back. Returns the lanes that transferred (bit l: node k + 3 l); then
+// given[l] is the volume lane l gave (m^3) and `transfers` the receiving neighbours of all
+// lanes (both unset when it returns 0), as erosion_visit8 does.
 // Heights p[0], p[3], p[6], p[9], widened to double.
 template <class Real>
 [[gnu::target("avx2"), gnu::always_inline]] inline Double4 every3(const Real* p) {
@@ -297,8 +309,8 @@ template <class Real>
                  static_cast<double>(p[9])};
 }
 template <int N, class Store>
-[[gnu::target("avx2")]] void erosion_visit4(Store& store, const ErosionTables& t, std::size_t k, const NodeClass& c,
-                                            bool reverse, VisitResult out[4]) {
+[[gnu::target("avx2")]] unsigned erosion_visit4(Store& store, const ErosionTables& t, std::size_t k, const NodeClass& c,
+                                                bool reverse, double given_out[4], std::size_t& transfers_out) {
   const auto* z = store.data() + k;
   const Double4 zi = every3(z);
   Double4 zj[N], e[N];
@@ -314,8 +326,8 @@ template <int N, class Store>
     largest = largest < e[s] ? e[s] : largest;
   }
   const Mask4 moving = sum > 0.0;
-  for (int l = 0; l < 4; ++l) out[l] = {};
-  if (_mm256_movemask_pd(reinterpret_cast<__m256d>(moving)) == 0) return;
+  const auto moving_bits = static_cast<unsigned>(_mm256_movemask_pd(reinterpret_cast<__m256d>(moving)));
+  if (moving_bits == 0) return 0;
   const Double4 one = {1.0, 1.0, 1.0, 1.0};
   const Double4 scale = t.fraction() * largest / (moving ? sum : one);  // 0 where nothing moves
   Double4 given = {0.0, 0.0, 0.0, 0.0}, error_m3 = {0.0, 0.0, 0.0, 0.0};
@@ -349,73 +361,22 @@ template <int N, class Store>
     const Double4 z_centre = zi - given * c.inv_area_i;
     for (int l = 0; l < 4; ++l) store.put(k + static_cast<std::size_t>(3 * l), z_centre[l]);
   }
-  for (int l = 0; l < 4; ++l) out[l] = {static_cast<int>(transfers[l]), given[l]};
+  std::memcpy(given_out, &given, sizeof given);
+  transfers_out = static_cast<std::size_t>(transfers[0] + transfers[1] + transfers[2] + transfers[3]);
+  return moving_bits;
 }
 
 // Which sweep erode_ordered runs (tests force one; Auto is what the terrains use). Dense
-// sweeps the members' row spans; DenseBaseline is Dense with its rows classed in SSE2
-// registers even where the CPU has AVX2 (tests: both give the same heights, bit for bit).
-enum class SweepPath { Auto, ActiveSet, Dense, DenseBaseline };
+// sweeps the members' row spans with the widest lanes the CPU has; DenseAvx2 is Dense with
+// AVX2 lanes even where the CPU has AVX-512; DenseBaseline is Dense with its rows classed in
+// SSE2 registers and one visit at a time (tests: all give the same heights, bit for bit).
+enum class SweepPath { Auto, ActiveSet, Dense, DenseAvx2, DenseBaseline };
 
 // Whether a pass sweeps the members' row spans (dense_pass) rather than the members: a dense
 // pass costs about a sixth of an active-set visit per node it skips (instructions,
 // callgrind; tests/bench/grid_bench.cpp), so it pays once the members fill about an eighth of
 // the spans from the first to the last member of each row.
 inline bool dense_pass_pays(std::size_t active, std::size_t span_nodes) { return active * 8 >= span_nodes; }
-
-// Bits of a row's flags, one per node (x at word x / 64, bit x % 64).
-inline bool bit_at(const std::uint64_t* bits, std::size_t x) { return (bits[x / 64] >> (x % 64)) & 1u; }
-// Ors the `count` low bits of `m` in at bit x (count <= 4; may straddle two words).
-inline void or_bits(std::uint64_t* bits, std::size_t x, std::uint64_t m) {
-  bits[x / 64] |= m << (x % 64);
-  if (x % 64 > 60) bits[x / 64 + 1] |= m >> (64 - x % 64);
-}
-// Sets bits [a, b].
-inline void set_bits(std::uint64_t* bits, std::size_t a, std::size_t b) {
-  for (std::size_t w = a / 64; w <= b / 64; ++w) {
-    const unsigned lo = w == a / 64 ? a % 64 : 0, hi = w == b / 64 ? b % 64 : 63;
-    bits[w] |= (hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & (~std::uint64_t{0} << lo);
-  }
-}
-// Sets bits ix - 2 .. ix + 2 (those below 0 dropped; `bits` must hold bit ix + 2).
-[[gnu::always_inline]] inline void near_bits(std::uint64_t* bits, std::size_t ix) {
-  const std::size_t lo = ix >= 2 ? ix - 2 : 0;
-  const std::uint64_t m = ix >= 2 ? 0x1Fu : 0x1Fu >> (2 - ix);
-  bits[lo / 64] |= m << (lo % 64);
-  if (lo % 64 > 59) bits[lo / 64 + 1] |= m >> (64 - lo % 64);
-}
-// The bits of word w for nodes x in [x0, x1].
-[[gnu::always_inline]] inline std::uint64_t word_range(std::size_t w, std::size_t x0, std::size_t x1) {
-  const unsigned lo = w == x0 / 64 ? x0 % 64 : 0, hi = w == x1 / 64 ? x1 % 64 : 63;
-  return (hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & (~std::uint64_t{0} << lo);
-}
-// The bits of word w for nodes x with x % 3 == r (64 = 1 mod 3: the pattern shifts by one per word).
-[[gnu::always_inline]] inline std::uint64_t columns_mod3(std::size_t r, std::size_t w) {
-  constexpr std::uint64_t kEvery3 = 0x9249249249249249ull;  // bits 0, 3, ..., 63
-  return kEvery3 << ((r + 3 - w % 3) % 3);
-}
-// The first node x in [from, to] with x % 3 == r and its bit set (false: none). O(words).
-[[gnu::always_inline]] inline bool next_in_class(const std::uint64_t* bits, std::size_t r, std::size_t from,
-                                                 std::size_t to, std::size_t& x) {
-  if (from > to) return false;
-  for (std::size_t w = from / 64; w <= to / 64; ++w)
-    if (const std::uint64_t m = bits[w] & columns_mod3(r, w) & word_range(w, from, to)) {
-      x = w * 64 + static_cast<std::size_t>(std::countr_zero(m));
-      return true;
-    }
-  return false;
-}
-// The last such node in [from, to].
-[[gnu::always_inline]] inline bool prev_in_class(const std::uint64_t* bits, std::size_t r, std::size_t from,
-                                                 std::size_t to, std::size_t& x) {
-  if (from > to) return false;
-  for (std::size_t w = to / 64 + 1; w-- > from / 64;)
-    if (const std::uint64_t m = bits[w] & columns_mod3(r, w) & word_range(w, from, to)) {
-      x = w * 64 + 63 - static_cast<std::size_t>(std::countl_zero(m));
-      return true;
-    }
-  return false;
-}
 
 // The thresholds of the interior class, copied (the flags could alias the class as far as
 // the compiler knows).
@@ -505,6 +466,16 @@ inline bool has_avx2() {
   return yes;
 }
 
+// The dense pass's vector width: rows classed two (SSE2), four (AVX2) or eight (AVX-512)
+// nodes at a time, and visits one at a time (SSE2), four (AVX2) or up to eight (AVX-512) at once.
+enum class Lanes { Sse2, Avx2, Avx512 };
+// The widest the CPU runs, at most what `path` asks for.
+inline Lanes lanes_for(SweepPath path) {
+  if (path == SweepPath::DenseBaseline) return Lanes::Sse2;
+  if (path != SweepPath::DenseAvx2 && has_avx512()) return Lanes::Avx512;
+  return has_avx2() ? Lanes::Avx2 : Lanes::Sse2;
+}
+
 // One dense pass, in place (Gauss-Seidel), rows in the direction the active set's next
 // sweep would take: in each row, every node from the first to the last member (the row's
 // span) is visited once. Like the active-set sweep it is live: a row's span also covers the
@@ -519,28 +490,30 @@ inline bool has_avx2() {
 // Order within a row: three phases, the columns x = r (mod 3) for each r in turn, each phase
 // in the sweep's x direction. Nodes three columns apart have disjoint 3 x 3 blocks, so the
 // visits of a phase do not depend on one another: the processor overlaps them, and on a
-// contiguous store with AVX2 four of them (k, k + 3, k + 6, k + 9) run at once, one per lane
-// (erosion_visit4, bit for bit four erosion_visit calls). It is still one visit after the
+// contiguous store up to eight of them (k, k + 3, ..., k + 21; erosion_visit8, AVX-512, masked
+// lanes where the span's interior ends) or four (erosion_visit4, AVX2) run at once, one per
+// lane, bit for bit those erosion_visit calls. It is still one visit after the
 // other (Gauss-Seidel, the energy argument above), in a different order from a plain row
 // sweep: an avalanche along x moves up to three nodes per pass in a row instead of the whole
 // run (along y, rows still follow each other). The order depends only on the active set, so
 // every store computes the same heights.
 //
 // Exactness of the shortcut. On a store with contiguous heights (HeightGrid: data()), a
-// row's interior nodes are first classed by unstable_bits (AVX2: four at a time), after the
+// row's interior nodes are first classed by unstable_bits (AVX-512: eight at a time; AVX2:
+// four), after the
 // previous row is done; a node is then visited only if it is flagged, on a border, or within
 // two columns of a node of its row that transferred before it (a visit writes into its 3 x 3
 // block, which a node up to two columns away reads). Its inputs are otherwise those it was
 // classed with, so skipping it is exactly what its visit would have done: the pass gives the
 // same heights, bit for bit, as visiting every node of the spans (which is what it does on
-// other stores, e.g. the sparse grid). `wide` = false classes in SSE2 registers and visits
-// one node at a time (the same heights; tests compare).
+// other stores, e.g. the sparse grid). `lanes` = Sse2 classes in SSE2 registers and visits
+// one node at a time, Avx2 four at a time (the same heights; tests compare).
 //
 // Cost: O(span nodes) per pass -- the classing vectorised over the row, one visit per
 // unstable node -- plus O(words of the visited rows) to find the spans and update the set.
 template <int N, bool Gradient, class Store, class Active>
 void dense_pass(Store& store, Active& active, const typename Active::Spans& spans, const ErosionTables& t,
-                ErosionReport& report, double& moved, bool wide = true) {
+                ErosionReport& report, double& moved, Lanes lanes) {
   const std::size_t nx = t.layout().nx, ny = t.layout().ny;
   const unsigned pass = active.next_sweep();
   const bool y_up = pass % 2 == 0;
@@ -551,9 +524,10 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
   constexpr bool kContiguous = requires { store.data(); };
   // The row's unstable nodes, one bit each (plus a word: or_bits may write one past the row).
   std::vector<std::uint64_t> flags(words + 1, 0);
-  const bool avx2 = wide && has_avx2();
   std::size_t prev_lo = 1, prev_hi = 0;  // span of the previous row's transfers (empty)
   std::size_t visited_rows = 0;
+  double moved_sum = moved;  // in visiting order, in a register
+  std::size_t transfer_count = 0;
   const std::size_t first = y_up ? spans.y0 : spans.y1;
   for (std::size_t iy = first; iy < ny; iy = y_up ? iy + 1 : iy - 1) {  // iy - 1 wraps below 0: stops
     std::size_t x0 = nx, x1 = 0;
@@ -585,7 +559,9 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
         if (skip_lo <= skip_hi) {
           const RowThresholds<N> c(middle, t.tan_settle() * t.tan_settle());
           const auto* row = store.data() + iy * nx;
-          if (avx2)
+          if (lanes == Lanes::Avx512)
+            unstable_bits_avx512<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
+          else if (lanes == Lanes::Avx2)
             unstable_bits_avx2<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
           else
             unstable_bits<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
@@ -600,12 +576,27 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     }
     std::size_t row_lo = nx, row_hi = 0;  // span of this row's transfers (empty)
     const auto transferred = [&](std::size_t ix, const VisitResult& v) {
-      report.transfers += static_cast<std::size_t>(v.transfers);
-      moved += v.moved;
+      transfer_count += static_cast<std::size_t>(v.transfers);
+      moved_sum += v.moved;
       moved_row[ix / 64] |= std::uint64_t{1} << (ix % 64);
       row_lo = std::min(row_lo, ix);
       row_hi = std::max(row_hi, ix);
       near_bits(must, ix);
+    };
+    // The same for the nodes a + 3 l of a group whose lanes l (bits of b) transferred, at once
+    // (volumes added in visiting order).
+    const auto group_transferred = [&](std::size_t a, unsigned b, const double* given, std::size_t transfers) {
+      for (unsigned rest = b; rest != 0;) {
+        const int l = x_up ? std::countr_zero(rest) : 31 - std::countl_zero(rest);
+        rest &= ~(1u << l);
+        moved_sum += given[l];
+      }
+      transfer_count += transfers;
+      const std::uint64_t at = kEveryThird[b];  // bit 3 l: node a + 3 l
+      or_bits32(moved_row, a, at);
+      or_bits32(must, a - 2, at | at << 1 | at << 2 | at << 3 | at << 4);  // near_bits of each
+      row_lo = std::min(row_lo, a + 3 * static_cast<std::size_t>(std::countr_zero(b)));
+      row_hi = std::max(row_hi, a + 3 * static_cast<std::size_t>(31 - std::countl_zero(b)));
     };
     const auto visit = [&](std::size_t ix) __attribute__((flatten)) {  // the store's reads and writes inlined
       const VisitResult v =
@@ -614,7 +605,9 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     };
     // Three phases, one per column modulo 3, each in the sweep's direction; on a contiguous
     // store, four nodes of a phase at once where they are interior nodes of the span.
-    const bool in_fours = avx2 && !Gradient && skip_lo <= skip_hi && nx >= 13;
+    // (the gradient rule in AVX-512 lanes only)
+    const bool in_groups =
+        (lanes == Lanes::Avx512 || (lanes == Lanes::Avx2 && !Gradient)) && skip_lo <= skip_hi && nx >= 13;
     const std::size_t four_lo = std::max<std::size_t>(x0, 2), four_hi = std::min(x1, nx - 3);
     for (std::size_t p = 0; p < 3; ++p) {
       const std::size_t r = x_up ? (x0 + p) % 3 : (x1 + 3 - p) % 3;
@@ -623,13 +616,28 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       while (x_up ? next_in_class(must, r, from, x1, ix) : prev_in_class(must, r, x0, from, ix)) {
         const std::size_t lowest = x_up ? ix : ix - std::min<std::size_t>(ix, 9);
         if constexpr (kContiguous) {
-          if (in_fours && lowest >= four_lo && lowest + 9 <= four_hi) {
-            VisitResult v[4];
-            erosion_visit4<N>(store, t, iy * nx + lowest, middle, !x_up, v);
-            for (int i = 0; i < 4; ++i) {
-              const int l = x_up ? i : 3 - i;
-              if (v[l].transfers > 0) transferred(lowest + 3 * static_cast<std::size_t>(l), v[l]);
-            }
+          // Up to eight nodes of the phase from ix on, in the span's interior (AVX-512).
+          const std::size_t room = !in_groups || lanes != Lanes::Avx512 || ix < four_lo || ix > four_hi ? 0
+                                   : x_up ? (four_hi - ix) / 3 + 1
+                                          : (ix - four_lo) / 3 + 1;
+          if (room >= 2) {
+            const std::size_t count = std::min<std::size_t>(8, room);
+            const std::size_t a = x_up ? ix : ix - 3 * (count - 1);
+            double given[8];
+            std::size_t transfers = 0;
+            if (const unsigned b =
+                    erosion_visit8<N, Gradient>(store, t, nx, iy * nx + a, count, middle, !x_up, given, transfers))
+              group_transferred(a, b, given, transfers);
+            const std::size_t last = x_up ? a + 3 * (count - 1) : a;
+            if (x_up ? last >= x1 : last <= x0) break;
+            from = x_up ? last + 1 : last - 1;
+            continue;
+          }
+          if (in_groups && lanes == Lanes::Avx2 && lowest >= four_lo && lowest + 9 <= four_hi) {
+            double given[4];
+            std::size_t transfers = 0;
+            if (const unsigned b = erosion_visit4<N>(store, t, iy * nx + lowest, middle, !x_up, given, transfers))
+              group_transferred(lowest, b, given, transfers);
             const std::size_t last = x_up ? lowest + 9 : lowest;
             if (x_up ? last >= x1 : last <= x0) break;
             from = x_up ? last + 1 : last - 1;
@@ -658,6 +666,8 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
                        moved_bits.begin() + static_cast<std::ptrdiff_t>((a + 1) * words),
                        moved_bits.begin() + static_cast<std::ptrdiff_t>(b * words));
   active.assign_blocks(moved_bits, std::min(first, last), std::max(first, last));
+  moved = moved_sum;
+  report.transfers += transfer_count;
 }
 
 // Passes until `active` is empty or the budget is spent: ordered, live sweeps of the active
@@ -675,11 +685,11 @@ ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t
     ++report.passes;
     if (path != SweepPath::ActiveSet) {
       const typename Active::Spans spans = active.spans();
-      const bool forced = path == SweepPath::Dense || path == SweepPath::DenseBaseline;
+      const bool forced = path == SweepPath::Dense || path == SweepPath::DenseAvx2 || path == SweepPath::DenseBaseline;
       const bool dense = forced || (dense_pass_pays(active.size(), spans.nodes) &&
                                     budget.max_updates - report.updates >= 2 * spans.nodes);
       if (dense) {
-        dense_pass<N, Gradient>(store, active, spans, t, report, moved, path != SweepPath::DenseBaseline);
+        dense_pass<N, Gradient>(store, active, spans, t, report, moved, lanes_for(path));
         continue;
       }
     }

@@ -58,6 +58,10 @@ class HeightGrid {
   double& carry() { return carry_.m3(); }
   // The heights, row-major (k = iy * nx + ix): the kernel's dense pass reads rows of them at once.
   const Real* data() const { return z_.data(); }
+  // The same, writable: the kernel's eight-node visits store rows of a block at once
+  // (erosion_lanes_avx512.hpp). Writes through it bypass the rounding carry: the kernel
+  // settles the carry itself.
+  Real* data() { return z_.data(); }
 
   double height(const Vec2& p) const { return bilinear_height(*this, p); }
   double volume() const { return trapezoid_volume(*this); }

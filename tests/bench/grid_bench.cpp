@@ -1,7 +1,8 @@
 // Grid back-end benchmarks: erosion throughput (node updates per second: one update is one
 // evaluation of the rule at one node) on realistic active sets of a 512 x 512 grid, on a
 // 2048 x 2048 grid with every node active, against a plain scalar in-place sweep of the same
-// rule in the same run (BM_ReferenceSweep), and stamp cost against tool area; float and double.
+// rule in the same run (BM_ReferenceSweep), and stamp cost against tool area; float and double;
+// the pile and stroke also with the gradient rule.
 //
 //   build/<dir>/tests/grid_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 //       --benchmark_enable_random_interleaving=true
@@ -49,9 +50,9 @@ sb::ToolStamp stamp_at(const sb::ToolSpec& spec, sb::Vec2 xy, sb::Vec2 motion) {
   return sb::make_stamp(spec, pose, motion, 0);
 }
 
-sb::ErosionRule rule() {
+sb::ErosionRule rule(sb::ErosionRuleKind kind = sb::ErosionRuleKind::Edge) {
   sb::Material m;  // 30 degrees, fraction 0.5
-  return sb::ErosionRule::from(m, 0.1);
+  return sb::ErosionRule::from(m, 0.1, kind);
 }
 
 // Two starting states for erosion.
@@ -80,12 +81,12 @@ GridTerrain<Real> prepared(Start start) {
 
 // state.range(0) erosion passes of the kernel (erosion_kernel.hpp; no multi-resolution
 // cascade) on a fresh copy of the prepared state each iteration (the copy is not timed).
-// Rates are per CPU second.
-template <class Real, Start kStart>
+// Rates are per CPU second. Edge rule; the Gradient variants: the gradient rule (the scenes' default).
+template <class Real, Start kStart, sb::ErosionRuleKind kKind = sb::ErosionRuleKind::Edge>
 void BM_Erosion(benchmark::State& state) {
   const int passes = static_cast<int>(state.range(0));
   const GridTerrain<Real> start = prepared<Real>(kStart);
-  const sb::ErosionRule r = rule();
+  const sb::ErosionRule r = rule(kKind);
   double updates = 0, transfers = 0;
   for (auto _ : state) {
     state.PauseTiming();
@@ -119,6 +120,16 @@ BENCHMARK(BM_Erosion<float, Start::Stroke>)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Erosion<double, Start::Stroke>)
     ->Name("BM_ErosionStroke<double>")
+    ->ArgName("passes")
+    ->Arg(64)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Erosion<double, Start::Pile, sb::ErosionRuleKind::Gradient>)
+    ->Name("BM_ErosionPileGradient<double>")
+    ->ArgName("passes")
+    ->Arg(64)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Erosion<double, Start::Stroke, sb::ErosionRuleKind::Gradient>)
+    ->Name("BM_ErosionStrokeGradient<double>")
     ->ArgName("passes")
     ->Arg(64)
     ->Unit(benchmark::kMillisecond);

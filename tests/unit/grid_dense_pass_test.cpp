@@ -3,9 +3,10 @@
 // double.
 //   - The dense pass's shortcut (rows classed several nodes at a time, stable nodes skipped)
 //     is exact: the dense grid (which takes it) and the sparse grid (which visits every node)
-//     give the same heights bit for bit, with the rows classed in AVX2 registers and four
-//     nodes visited at once in AVX2 lanes (where the CPU has them) or classed in SSE2
-//     registers and visited one at a time (SweepPath::DenseBaseline); also on wide rows.
+//     give the same heights bit for bit, with the rows classed and up to eight nodes visited
+//     at once in AVX-512 lanes (SweepPath::Dense, where the CPU has them), four at once in
+//     AVX2 lanes (SweepPath::DenseAvx2, where the CPU has them), or classed in SSE2 registers
+//     and visited one at a time (SweepPath::DenseBaseline); also on wide rows.
 //   - Dense and active-set paths conserve volume exactly (reported changes against volume()),
 //     both settle, and reach surfaces within a small height tolerance of each other.
 #include <gtest/gtest.h>
@@ -68,6 +69,8 @@ class DensePass : public ::testing::TestWithParam<Case> {
       auto plain = rough_terrain<SparseGridTerrain<Real>>(c, seed, SweepPath::Dense, layout);
       // SSE2 classing, one node at a time
       auto narrow = rough_terrain<GridTerrain<Real>>(c, seed, SweepPath::DenseBaseline, layout);
+      // AVX2 lanes even where the CPU has AVX-512
+      auto avx2 = rough_terrain<GridTerrain<Real>>(c, seed, SweepPath::DenseAvx2, layout);
       const double v0 = dense->volume();
       double tracked = v0;
       for (int call = 0; call < 5; ++call) {
@@ -75,20 +78,28 @@ class DensePass : public ::testing::TestWithParam<Case> {
         tracked += a.volume_change_m3;
         const ErosionReport b = plain->erode(rule, {.max_passes = 3});
         const ErosionReport n = narrow->erode(rule, {.max_passes = 3});
+        const ErosionReport w = avx2->erode(rule, {.max_passes = 3});
         EXPECT_EQ(a.transfers, b.transfers);
         EXPECT_EQ(a.active, b.active);
         EXPECT_EQ(a.updates, b.updates);
         EXPECT_EQ(a.transfers, n.transfers);
         EXPECT_EQ(a.updates, n.updates);
+        EXPECT_EQ(a.transfers, w.transfers);
+        EXPECT_EQ(a.updates, w.updates);
+        EXPECT_EQ(a.volume_moved_m3, w.volume_moved_m3);  // the same additions in the same order
+        EXPECT_EQ(a.volume_moved_m3, n.volume_moved_m3);
       }
-      const std::vector<double> za = heights_of(*dense), zb = heights_of(*plain), zn = heights_of(*narrow);
-      std::size_t differing = 0, differing_narrow = 0;
+      const std::vector<double> za = heights_of(*dense), zb = heights_of(*plain), zn = heights_of(*narrow),
+                                zw = heights_of(*avx2);
+      std::size_t differing = 0, differing_narrow = 0, differing_avx2 = 0;
       for (std::size_t k = 0; k < za.size(); ++k) {
         differing += std::memcmp(&za[k], &zb[k], sizeof(double)) != 0;
         differing_narrow += std::memcmp(&za[k], &zn[k], sizeof(double)) != 0;
+        differing_avx2 += std::memcmp(&za[k], &zw[k], sizeof(double)) != 0;
       }
       EXPECT_EQ(differing, 0u) << "seed " << seed;
       EXPECT_EQ(differing_narrow, 0u) << "seed " << seed;
+      EXPECT_EQ(differing_avx2, 0u) << "seed " << seed;
       EXPECT_NEAR(tracked, dense->volume(), (c.is_float ? 1e-12 : 1e-14) * v0);  // transfers conserve volume
       EXPECT_TRUE(dense->check().ok());
     }
