@@ -128,45 +128,52 @@ A comparison is only worth what its weakest contender is. These judgements come 
 interleaved runs made during development (medians on a shared 2-core machine; see the project's closing
 notes); the tables below are this run's.
 
-- **TIN step time on the trench**: was **our code**, now mostly the method. Each stamp re-activated its whole
-  re-triangulated region, convex tools kept corners the mesh cannot resolve, contour pieces were
-  subdivided far below the refinement length, and every erosion visit walked the triangulation for its
-  neighbours; with those fixed (a ring cached per active vertex between passes, no allocation per visit:
-  0.31 -> 0.20 us per visit) the TIN trench step went from 8.5-9.5x to 5.0-5.5x the grid's. What remains
-  is the price of a visit (scattered vertex records, about five times a grid node's time) and of
-  re-triangulating around every stamp (about 0.4 ms of a 1.3 ms step): the method.
-- **TIN pile with the default (gradient) rule** (flank about 27 degrees, roundness 0.075, RMSE 4.7x the
-  grid's): two parts, told apart by the pile-relaxed table below. **Our code, in the flow that builds a pile
-  from a point**: the same sand standing at 35 degrees and relaxing ends round on the TIN (29.5 degrees,
-  roundness 0.025, RMSE 67 um with 283 vertices), but poured as 20 spikes it ends lobed (lower along some
-  directions, higher along others), and refining the TIN uniformly to 3 mm edges (2300 vertices, 20x the
-  grid's step) leaves it lobed (roundness 0.06): not the mesh's resolution but how avalanches far from rest
-  travel on its edges. Faces at rest stand at 30.1 degrees; a lobed pile with stable faces is at rest under
-  any local rule. Not fixed: a smaller pour per stamp, a wider pour, a smaller transfer fraction and
-  per-pair facet gradients all left it lobed or worse; more passes per step (64) helped a little (0.042);
-  letting the gradient rule act only toward neighbours within 30 degrees of downhill gave the edge rule's
-  pile (29.5 degrees, 0.048) but trench walls up to 3.8 degrees steep; concentric rings of vertices put
-  around the pour point before it pours gave roundness 0.021 and RMSE 61 um when 5 mm apart but 0.056-0.068
-  when 4 or 6 mm apart: the avalanche follows the mesh's edges, and which lobes form depends on them.
-  **The method, for the rest**: relaxed, the TIN's 283 vertices (0.4x the grid's memory) give 3.4x the
-  grid's RMSE (67 against 20 um): a piecewise-linear cone on edges of about 7 mm errs near its apex and toe.
-  Refining where facet gradients jump (`tin.curvature_tolerance_m = 0.0003`) gives the poured pile 1.85x the
-  grid's RMSE at 5.7x its step time.
+- **TIN step time on the trench**: was **our code** several times over, now the method. Each stamp
+  re-activated its whole re-triangulated region, convex tools kept corners the mesh cannot resolve, contour
+  pieces were subdivided far below the refinement length, every erosion visit walked the triangulation for
+  its neighbours, and the walls of passed stamps left vertex pairs under a millimetre apart (tiny areas
+  that throttle every transfer through them; now thinned once the stamp has passed). With those fixed the
+  TIN's trench step fell from 1.24 to 0.95 ms in this round (interleaved medians). The grid, brought to its
+  own limit in the same round (AVX-512 lanes, the gradient rule in them), fell from 0.24 to 0.10 ms, so the
+  ratio went from 5.2x to 9.2x: what remains is the price of a TIN visit (scattered vertex records, a ring,
+  cotangent weights: several grid node visits' time) and of re-triangulating around every stamp, against
+  a grid kernel that visits eight nodes at once: **the method**.
+- **TIN pile with the default (gradient) rule**: was **our code**, fixed; what is left is the method at
+  this resolution. The pile came out lobed (flank 26.8 degrees, roundness 0.075, RMSE 164 um, 4.7x the
+  grid's) although the same sand relaxing from a 35-degree cone ended round: the flow, not the rest state
+  (the pile-relaxed table below). Two causes: (1) a transfer was shared among the neighbours in proportion
+  to their volume excess, which weights them by their areas, so avalanches ran along the mesh's
+  directions (on a regular lattice triangulated one way the pile came out as a ridge, roundness 0.22); it
+  is now shared by conductance times excess height, with cotangent weights on a TIN (transport without a
+  preferred direction on any triangulation; the regular lattice: 0.05); (2) vertex pairs under a
+  millimetre apart throttled the flow (above). Now, in this round's interleaved runs: RMSE 56 um (1.6x the
+  grid's 35), flank 29.5 degrees, roundness 0.023, with 339 vertices (0.5x the grid's memory); settling
+  about 3x the grid's. Tried and not kept: per-pair facet gradients, restricting the gradient rule to
+  neighbours within 30 degrees of downhill (the edge rule's pile, but trench walls up to 3.8 degrees
+  steep), rings of vertices around the pour point (roundness 0.021 or 0.068 depending on their spacing).
+  **The method, for the rest**: a piecewise-linear cone on 7 mm edges errs near its apex and toe;
+  refining where facet gradients jump (`tin.curvature_tolerance_m = 0.0003`, "tin curved" in the
+  orientation tables) gives RMSE 42 um (1.2x the grid's), flank 29.8 degrees and roundness 0.017 with 529
+  vertices (0.7x the grid's memory), at about 10x the grid's step time.
 - **TIN simplification**: was **our code** (the paper's step 3 never removed a vertex on a flat bed), fixed:
   once the terrain is at rest, near-planar vertices are removed (volume kept, no triangle tilted past the
   stable slope), tens per shipped scene; during strokes the paper's alpha_flat rule alone acts.
 - **TIN trench walls**: the paper's edge rule leaves them 1-4 degrees steeper than critical (a triangle
   whose edges are all stable can stand steeper); the gradient rule brings their mean to within 0.1
-  degree of critical at every azimuth (orientation table): **the rule**, now fixed by default.
+  degree of critical at every azimuth (orientation table): **the rule**, now fixed by default. Single
+  cross-sections still stray up to 1.3 degrees on the default mesh (0.35 with curvature refinement, at
+  about 2.5x the TIN's step time): **the method's resolution**.
 - **TIN memory**: **the method**. A vertex with its triangles costs about 170 bytes against a grid node's
   10, so the TIN wins only where it needs about 17 times fewer elements than a grid of the same accuracy.
-- **Grid speed**: partly **our code** still, partly the rule. The dense pass now skips stable nodes by
-  bit scans over vector-classed rows and visits four independent nodes at once (columns modulo 3, AVX2
-  lanes, bit for bit four scalar visits): 61-81 M updates/s on pile and stroke states (from 36-51) and
-  113 M/s with every node active, 7.4-7.9x a plain scalar sweep of the same rule. Memory bandwidth would
-  allow more; what stops it is the in-place (Gauss-Seidel) order that the default transfer fraction needs
-  to stay monotone (a Jacobi or four-colour sweep overshoots at f = 0.5) and, in float, the rounding carry
-  that chains every transfer to the one before.
+- **Grid speed**: was **our code**, now near the method's limit in double. The dense pass skips stable
+  nodes by bit scans over vector-classed rows and visits up to eight independent nodes at once (columns
+  modulo 3; AVX-512 lanes with masked ends, the gradient rule included; AVX2 and SSE2 where the CPU lacks
+  them), bit for bit the scalar visits: on `grid_bench`'s states 79 M updates/s on the pile and 121 M on
+  the stroke (36-51 two rounds ago), 155 M with every node active, 10.5x a plain scalar sweep of the same
+  rule (helper's interleaved medians). What stops it short of memory bandwidth: the in-place
+  (Gauss-Seidel) order that the default transfer fraction needs to stay monotone (a Jacobi or four-colour
+  sweep overshoots at f = 0.5), the permutes that gather a 3 x 3 block per lane, and, in float, the
+  rounding carry that chains every transfer to the one before.
 - **Grid settling of large grids**: was **our code**, fixed. Fine passes alone are diffusive (passes grow
   about 3.5x per halving of the cell, time as n^1.9); a coarse-to-fine cascade relaxes 2 x 2 blocks of
   blocks with the same kernel, adds each level's change to its children (exact volume, energy never
