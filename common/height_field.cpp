@@ -72,10 +72,9 @@ double HeightField::operator()(const Vec2& p) const {
     case TerrainKind::Flat:
       return base_m_;
     case TerrainKind::Plane:
-      return base_m_ + plane_gradient_.dot(p - (domain_.origin_m + 0.5 * domain_.size_m));
+      return base_m_ + plane_gradient_.dot(p - domain_.centre());
     case TerrainKind::Cone:
-      return base_m_ +
-             cone_tan_ * std::max(0.0, cone_radius_m_ - (p - (domain_.origin_m + 0.5 * domain_.size_m)).norm());
+      return base_m_ + cone_tan_ * std::max(0.0, cone_radius_m_ - (p - domain_.centre()).norm());
     case TerrainKind::Dunes: {
       double sum = 0.0;
       for (const Ridge& r : ridges_) {

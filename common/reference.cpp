@@ -24,7 +24,7 @@ PileSetup pile_setup(const Scene& scene, const StampSchedule& schedule) {
   p.centre = schedule.stamps.front().pose.xy;
   if (scene.terrain.kind == TerrainKind::Cone) {
     p.volume_m3 += scene.terrain.cone_volume_m3;
-    p.centre = scene.domain.origin_m + 0.5 * scene.domain.size_m;
+    p.centre = scene.domain.centre();
     p.on_cone = true;
   }
   return p;

@@ -22,6 +22,7 @@ struct DomainSpec {
   Vec2 origin_m{0.0, 0.0};
   Vec2 size_m{0.7071067811865476, 0.7071067811865476};
   Aabb2 box() const { return {origin_m, origin_m + size_m}; }
+  Vec2 centre() const { return origin_m + 0.5 * size_m; }
 };
 
 struct TerrainSpec {

@@ -149,7 +149,7 @@ std::unique_ptr<Setup> build_from_scene(std::int64_t n) {
   } else {
     s->scene = sb::load_scene(std::string(SB_SOURCE_DIR) + "/experiments/scenes/heightmap.toml");
   }
-  s->centre = s->scene.domain.origin_m + 0.5 * s->scene.domain.size_m;
+  s->centre = s->scene.domain.centre();
   s->rule = sb::ErosionRule::from(s->scene.material, s->scene.erosion.settle_tolerance_deg, s->scene.erosion.rule);
   s->terrain = sb::tin::make_tin_terrain(s->scene, sb::HeightField::from_scene(s->scene));
   s->from_scene = true;
