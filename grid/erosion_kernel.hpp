@@ -476,6 +476,19 @@ inline Lanes lanes_for(SweepPath path) {
   return has_avx2() ? Lanes::Avx2 : Lanes::Sse2;
 }
 
+// The height type of a store's row copies (Store::value_type where it copies rows; unused otherwise).
+template <class Store>
+struct RowCopyRealOf {
+  using type = double;
+};
+template <class Store>
+requires requires { typename Store::value_type; }
+struct RowCopyRealOf<Store> {
+  using type = typename Store::value_type;
+};
+template <class Store>
+using RowCopyReal = typename RowCopyRealOf<Store>::type;
+
 // One dense pass, in place (Gauss-Seidel), rows in the direction the active set's next
 // sweep would take: in each row, every node from the first to the last member (the row's
 // span) is visited once. Like the active-set sweep it is live: a row's span also covers the
@@ -522,12 +535,17 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
   // The nodes that transferred, one row of words per visited row in visiting order.
   std::vector<std::uint64_t> moved_bits;
   constexpr bool kContiguous = requires { store.data(); };
+  // A store without contiguous heights that can copy a row's (the sparse grid) has its rows
+  // classed in a copy of the three rows they read (the visits stay one at a time).
+  constexpr bool kRowCopies = requires { store.read_row(0, 0, 0, nullptr); };
+  std::vector<RowCopyReal<Store>> rows_copy(kRowCopies ? 3 * nx : 0);
   // The row's unstable nodes, one bit each (plus a word: or_bits may write one past the row).
   std::vector<std::uint64_t> flags(words + 1, 0);
   std::size_t prev_lo = 1, prev_hi = 0;  // span of the previous row's transfers (empty)
   std::size_t visited_rows = 0;
   double moved_sum = moved;  // in visiting order, in a register
   std::size_t transfer_count = 0;
+  std::size_t col_lo = nx, col_hi = 0;  // columns of the visited spans: every member and transfer lies in them
   const std::size_t first = y_up ? spans.y0 : spans.y1;
   for (std::size_t iy = first; iy < ny; iy = y_up ? iy + 1 : iy - 1) {  // iy - 1 wraps below 0: stops
     std::size_t x0 = nx, x1 = 0;
@@ -552,13 +570,21 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     std::fill(flags.begin() + static_cast<std::ptrdiff_t>(x0 / 64),
               flags.begin() + static_cast<std::ptrdiff_t>(x1 / 64 + 2), std::uint64_t{0});
     std::size_t skip_lo = 1, skip_hi = 0;  // nodes classed (empty: none)
-    if constexpr (kContiguous) {
+    if constexpr (kContiguous || kRowCopies) {
       if (iy > 0 && iy + 1 < ny && nx >= 3) {
         skip_lo = std::max<std::size_t>(1, x0);
         skip_hi = std::min(nx - 2, x1);
         if (skip_lo <= skip_hi) {
           const RowThresholds<N> c(middle, t.tan_settle() * t.tan_settle());
-          const auto* row = store.data() + iy * nx;
+          const auto* row = [&] {
+            if constexpr (kContiguous) {
+              return store.data() + iy * nx;
+            } else {  // columns skip_lo - 1 .. skip_hi + 1 of the three rows, copied
+              for (std::size_t r = 0; r < 3; ++r)
+                store.read_row(iy + r - 1, skip_lo - 1, skip_hi + 1, rows_copy.data() + r * nx + skip_lo - 1);
+              return static_cast<const RowCopyReal<Store>*>(rows_copy.data() + nx);
+            }
+          }();
           if (lanes == Lanes::Avx512)
             unstable_bits_avx512<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
           else if (lanes == Lanes::Avx2)
@@ -656,6 +682,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       while (x0 > 0 && bit_at(moved_row, x0)) visit(--x0);
     }
     report.updates += x1 - x0 + 1;
+    col_lo = std::min(col_lo, x0), col_hi = std::max(col_hi, x1);
     if (row_lo <= row_hi) prev_lo = row_lo, prev_hi = row_hi;
   }
   // Rows in increasing y for the set.
@@ -665,7 +692,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       std::swap_ranges(moved_bits.begin() + static_cast<std::ptrdiff_t>(a * words),
                        moved_bits.begin() + static_cast<std::ptrdiff_t>((a + 1) * words),
                        moved_bits.begin() + static_cast<std::ptrdiff_t>(b * words));
-  active.assign_blocks(moved_bits, std::min(first, last), std::max(first, last));
+  active.assign_blocks(moved_bits, std::min(first, last), std::max(first, last), col_lo, col_hi);
   moved = moved_sum;
   report.transfers += transfer_count;
 }
