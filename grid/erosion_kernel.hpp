@@ -27,9 +27,11 @@
 //   void activate_block(std::size_t ix, std::size_t iy);  // node and its 3 x 3 block
 //   Spans spans() const; bool row_span(y, x0&, x1&) const; unsigned next_sweep();
 //   std::size_t words_per_row() const;
-//   void assign_blocks(centres, y0, y1);  // the dense pass's bookkeeping
+//   void assign_blocks(centres, y0, y1, x0, x1);  // the dense pass's bookkeeping
 // Node indices are those of the GridLayout (k = iy * nx + ix); a sparse store maps them to
-// its own coordinates.
+// its own coordinates. A store may also offer data() (contiguous heights, HeightGrid), or
+// read_row / write_changed (SparseHeights: the dense pass then runs each row on a
+// RowWindow, grid/row_window.hpp, a contiguous copy of the three rows it touches).
 //
 // Conservation. Each transfer V from i to j writes z_j + V / A_j and takes the same V
 // from the centre: A_i dz_i = -sum_j A_j dz_j up to the rounding of the stored heights.
@@ -110,6 +112,7 @@
 #include <cstring>
 #include <limits>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "common/erosion.hpp"
@@ -117,6 +120,7 @@
 #include "grid/erosion_lanes_avx512.hpp"
 #include "grid/grid_layout.hpp"
 #include "grid/row_bits.hpp"
+#include "grid/row_window.hpp"
 
 // _mm256_movemask_pd, in the AVX2 functions only (compiled for AVX2 by their target attribute).
 #include <immintrin.h>
@@ -476,18 +480,22 @@ inline Lanes lanes_for(SweepPath path) {
   return has_avx2() ? Lanes::Avx2 : Lanes::Sse2;
 }
 
-// The height type of a store's row copies (Store::value_type where it copies rows; unused otherwise).
-template <class Store>
-struct RowCopyRealOf {
-  using type = double;
+// The RowWindow a store's dense pass runs its rows on (stores that copy rows), else nothing.
+struct NoWindow {
+  template <class Store>
+  NoWindow(Store&, std::size_t, std::size_t) {}
 };
 template <class Store>
-requires requires { typename Store::value_type; }
-struct RowCopyRealOf<Store> {
-  using type = typename Store::value_type;
+struct WindowOfStore {
+  using type = NoWindow;
 };
 template <class Store>
-using RowCopyReal = typename RowCopyRealOf<Store>::type;
+requires requires(Store& s) { s.read_row(0, 0, 0, nullptr); }
+struct WindowOfStore<Store> {
+  using type = RowWindow<Store>;
+};
+template <class Store>
+using WindowOf = typename WindowOfStore<Store>::type;
 
 // One dense pass, in place (Gauss-Seidel), rows in the direction the active set's next
 // sweep would take: in each row, every node from the first to the last member (the row's
@@ -511,15 +519,14 @@ using RowCopyReal = typename RowCopyRealOf<Store>::type;
 // run (along y, rows still follow each other). The order depends only on the active set, so
 // every store computes the same heights.
 //
-// Exactness of the shortcut. On a store with contiguous heights (HeightGrid: data()), a
-// row's interior nodes are first classed by unstable_bits (AVX-512: eight at a time; AVX2:
-// four), after the
-// previous row is done; a node is then visited only if it is flagged, on a border, or within
-// two columns of a node of its row that transferred before it (a visit writes into its 3 x 3
+// Exactness of the shortcut. On a store with contiguous heights (HeightGrid: data(); the
+// sparse grid's RowWindow), a row's interior nodes are first classed by unstable_bits
+// (AVX-512: eight at a time; AVX2: four), after the previous row is done; a node is then visited only if it is flagged,
+// on a border, or within two columns of a node of its row that transferred before it (a visit writes into its 3 x 3
 // block, which a node up to two columns away reads). Its inputs are otherwise those it was
 // classed with, so skipping it is exactly what its visit would have done: the pass gives the
 // same heights, bit for bit, as visiting every node of the spans (which is what it does on
-// other stores, e.g. the sparse grid). `lanes` = Sse2 classes in SSE2 registers and visits
+// stores with neither data() nor read_row). `lanes` = Sse2 classes in SSE2 registers and visits
 // one node at a time, Avx2 four at a time (the same heights; tests compare).
 //
 // Cost: O(span nodes) per pass -- the classing vectorised over the row, one visit per
@@ -534,11 +541,19 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
   const std::size_t words = active.words_per_row();
   // The nodes that transferred, one row of words per visited row in visiting order.
   std::vector<std::uint64_t> moved_bits;
-  constexpr bool kContiguous = requires { store.data(); };
-  // A store without contiguous heights that can copy a row's (the sparse grid) has its rows
-  // classed in a copy of the three rows they read (the visits stay one at a time).
-  constexpr bool kRowCopies = requires { store.read_row(0, 0, 0, nullptr); };
-  std::vector<RowCopyReal<Store>> rows_copy(kRowCopies ? 3 * nx : 0);
+  // A store without contiguous heights that copies rows (the sparse grid) runs each row on a
+  // RowWindow of the three rows it touches (node k = nx + ix of the row), as a contiguous
+  // store runs it on its own heights (node k = iy * nx + ix).
+  constexpr bool kWindowed = requires { store.read_row(0, 0, 0, nullptr); };
+  [[maybe_unused]] WindowOf<Store> window(store, nx, ny);
+  auto& rs = [&]() -> auto& {
+    if constexpr (kWindowed)
+      return window;
+    else
+      return store;
+  }
+  ();
+  constexpr bool kContiguous = requires { rs.data(); };
   // The row's unstable nodes, one bit each (plus a word: or_bits may write one past the row).
   std::vector<std::uint64_t> flags(words + 1, 0);
   std::size_t prev_lo = 1, prev_hi = 0;  // span of the previous row's transfers (empty)
@@ -570,21 +585,16 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     std::fill(flags.begin() + static_cast<std::ptrdiff_t>(x0 / 64),
               flags.begin() + static_cast<std::ptrdiff_t>(x1 / 64 + 2), std::uint64_t{0});
     std::size_t skip_lo = 1, skip_hi = 0;  // nodes classed (empty: none)
-    if constexpr (kContiguous || kRowCopies) {
+    // The row's first node on the store it runs on.
+    const std::size_t row_k = kWindowed ? nx : iy * nx;
+    if constexpr (kWindowed) window.load(iy, x0 > 0 ? x0 - 1 : 0, std::min(x1 + 1, nx - 1));
+    if constexpr (kContiguous) {
       if (iy > 0 && iy + 1 < ny && nx >= 3) {
         skip_lo = std::max<std::size_t>(1, x0);
         skip_hi = std::min(nx - 2, x1);
         if (skip_lo <= skip_hi) {
           const RowThresholds<N> c(middle, t.tan_settle() * t.tan_settle());
-          const auto* row = [&] {
-            if constexpr (kContiguous) {
-              return store.data() + iy * nx;
-            } else {  // columns skip_lo - 1 .. skip_hi + 1 of the three rows, copied
-              for (std::size_t r = 0; r < 3; ++r)
-                store.read_row(iy + r - 1, skip_lo - 1, skip_hi + 1, rows_copy.data() + r * nx + skip_lo - 1);
-              return static_cast<const RowCopyReal<Store>*>(rows_copy.data() + nx);
-            }
-          }();
+          const auto* row = std::as_const(rs).data() + row_k;
           if (lanes == Lanes::Avx512)
             unstable_bits_avx512<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
           else if (lanes == Lanes::Avx2)
@@ -625,8 +635,9 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       row_hi = std::max(row_hi, a + 3 * static_cast<std::size_t>(31 - std::countl_zero(b)));
     };
     const auto visit = [&](std::size_t ix) __attribute__((flatten)) {  // the store's reads and writes inlined
+      if constexpr (kWindowed) window.extend(ix > 0 ? ix - 1 : 0, std::min(ix + 1, nx - 1));  // the span grew
       const VisitResult v =
-          erosion_visit<N, Gradient>(store, t, iy * nx + ix, ix < 2 || ix + 2 >= nx ? t.of(ix, iy) : middle);
+          erosion_visit<N, Gradient>(rs, t, row_k + ix, ix < 2 || ix + 2 >= nx ? t.of(ix, iy) : middle);
       if (v.transfers > 0) transferred(ix, v);
     };
     // Three phases, one per column modulo 3, each in the sweep's direction; on a contiguous
@@ -652,7 +663,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
             double given[8];
             std::size_t transfers = 0;
             if (const unsigned b =
-                    erosion_visit8<N, Gradient>(store, t, nx, iy * nx + a, count, middle, !x_up, given, transfers))
+                    erosion_visit8<N, Gradient>(rs, t, nx, row_k + a, count, middle, !x_up, given, transfers))
               group_transferred(a, b, given, transfers);
             const std::size_t last = x_up ? a + 3 * (count - 1) : a;
             if (x_up ? last >= x1 : last <= x0) break;
@@ -662,7 +673,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
           if (in_groups && lanes == Lanes::Avx2 && lowest >= four_lo && lowest + 9 <= four_hi) {
             double given[4];
             std::size_t transfers = 0;
-            if (const unsigned b = erosion_visit4<N>(store, t, iy * nx + lowest, middle, !x_up, given, transfers))
+            if (const unsigned b = erosion_visit4<N>(rs, t, row_k + lowest, middle, !x_up, given, transfers))
               group_transferred(lowest, b, given, transfers);
             const std::size_t last = x_up ? lowest + 9 : lowest;
             if (x_up ? last >= x1 : last <= x0) break;
@@ -681,6 +692,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     } else {
       while (x0 > 0 && bit_at(moved_row, x0)) visit(--x0);
     }
+    if constexpr (kWindowed) window.store_back();
     report.updates += x1 - x0 + 1;
     col_lo = std::min(col_lo, x0), col_hi = std::max(col_hi, x1);
     if (row_lo <= row_hi) prev_lo = row_lo, prev_hi = row_hi;
