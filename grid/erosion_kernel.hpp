@@ -541,6 +541,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
   const std::size_t words = active.words_per_row();
   // The nodes that transferred, one row of words per visited row in visiting order.
   std::vector<std::uint64_t> moved_bits;
+  moved_bits.reserve((spans.y1 - spans.y0 + 3) * words);  // the members' rows and one each way, as a rule
   // A store without contiguous heights that copies rows (the sparse grid) runs each row on a
   // RowWindow of the three rows it touches (node k = nx + ix of the row), as a contiguous
   // store runs it on its own heights (node k = iy * nx + ix).
@@ -611,7 +612,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       if (x1 > skip_hi) set_bits(must, skip_hi + 1, x1);
     }
     std::size_t row_lo = nx, row_hi = 0;  // span of this row's transfers (empty)
-    const auto transferred = [&](std::size_t ix, const VisitResult& v) {
+    const auto transferred = [&](std::size_t ix, const VisitResult& v) __attribute__((always_inline)) {
       transfer_count += static_cast<std::size_t>(v.transfers);
       moved_sum += v.moved;
       moved_row[ix / 64] |= std::uint64_t{1} << (ix % 64);
@@ -621,7 +622,8 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     };
     // The same for the nodes a + 3 l of a group whose lanes l (bits of b) transferred, at once
     // (volumes added in visiting order).
-    const auto group_transferred = [&](std::size_t a, unsigned b, const double* given, std::size_t transfers) {
+    const auto group_transferred = [&](std::size_t a, unsigned b, const double* given, std::size_t transfers)
+        __attribute__((always_inline)) {
       for (unsigned rest = b; rest != 0;) {
         const int l = x_up ? std::countr_zero(rest) : 31 - std::countl_zero(rest);
         rest &= ~(1u << l);
