@@ -88,21 +88,25 @@
 // neighbour, plus per transfer one division, and a store per receiving neighbour and one
 // for the centre (visits in vector lanes write every slot: no branch per slot); the
 // gradient rule adds a square root and a division per visit. Measured with AVX-512 (Zen 4,
-// tests/bench/grid_bench.cpp, edge rule, 8 neighbours, CPU time, medians of three runs
-// interleaved with the build before the AVX-512 lanes), M updates/s (an update: one node of
-// a span or one active-set visit): double 79 on the pile (before: 64), 121 on the stroke
-// (81), 155 with every node of 2048^2 active (104; 10.5x the plain scalar sweep in the same
-// runs, before 7.5x); float 40 (40), 58 (47), 86 (71); the gradient rule (AVX-512 lanes
-// only; AVX2 visits it one node at a time), double: 54 on the pile and 79 on the stroke
-// (one node at a time: 21 and 24). Measured in the AVX2 lanes
-// (callgrind, which runs no AVX-512), instructions per update, double / float, now (before
-// the group bookkeeping; before the three phases and the AVX2 lanes): every node of 2048^2
-// active 107 double (111 / 150; 175 / 208), grid_bench's pile 212 / 271 (222 / 281; 307 /
-// 363), its stroke 150 / 203 (160 / 213; 243 / 289). Four visits in AVX2 lanes take ~320 instructions
-// (double); classing a row ~16 per node (AVX2, double; ~29 float); rebuilding the active set
-// after a dense pass ~8 per node of the rows. Active-set visits add ~100 for the set's
-// bookkeeping. Float costs more than its instructions: the rounding carry chains every
-// transferring visit to the one before (float gains least from the wider lanes).
+// tests/bench/grid_bench.cpp, edge rule, 8 neighbours, CPU time, medians of five runs
+// interleaved with the build before the bookkeeping was inlined and cut to the visited
+// columns), M updates/s (an update: one node of a span or one active-set visit): double 90
+// on the pile (before: 83), 135 on the stroke (128), 162 with every node of 2048^2 active
+// (164; 10.8x the plain scalar sweep in the same runs); float 45 (43), 61 (58), 87 (84); the
+// gradient rule (AVX-512 lanes only; AVX2 visits it one node at a time), double: 60 on the
+// pile and 87 on the stroke (57, 83). Measured in the AVX2 lanes (callgrind, which runs no
+// AVX-512), instructions per update, double / float, now (before): grid_bench's pile 199 /
+// 259 (211 / 270), its stroke 141 / 194 (150 / 202); every node of 2048^2 active ~107
+// double. Four visits in AVX2 lanes take ~320 instructions (double); classing a row ~16
+// per node (AVX2, double; ~29 float); rebuilding the active set after a dense pass ~8 per
+// node of the visited columns. Active-set visits add ~100 for the set's bookkeeping. Float
+// costs more than its instructions: the rounding carry chains every transferring visit to
+// the one before (float gains least from the wider lanes). Where the time goes with
+// AVX-512 (perf, sampled): on the pile, ~45 % in the eight-node visits, ~30 % in the pass's
+// bookkeeping (phases, flags, the set's rebuild), ~10 % classing; with every node active,
+// ~53 % visits, ~24 % classing, ~22 % bookkeeping. The sparse grid runs the same paths on a
+// RowWindow (row_window.hpp): three rows copied in and the changed heights written back per
+// row, O(span) each.
 #include <algorithm>
 #include <array>
 #include <bit>
