@@ -43,18 +43,15 @@ double TinTerrain::gather_neighbours(VertexHandle v) {
 
 VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* inserted) {
   const Vec2 m = 0.5 * (xy(a) + xy(b));
-  // The faces whose circumcircle meets a box of a quarter of the edge around its middle: a box of
-  // a few snap lengths around it once missed a face that the insertion changed (a 37 mm edge, in
-  // TinStress.RandomStrokes), and the volume give-back needs every changed face.
-  Capture capture = begin_capture(Aabb2{m, m}.expanded(0.25 * (xy(a) - xy(b)).norm()));
-  const VertexHandle v = insert_point(m, height(m), inserted);
-  const CaptureResult measured = end_capture(capture);
+  double change = 0.0;
+  const VertexHandle v = insert_point(m, height(m), inserted, &change);
   if (!*inserted) return v;
   // The split itself keeps the surface; the Delaunay flips after it may not: their volume
-  // change is given back to the new vertex (tin.conserve_volume, the default).
-  if (spec_.conserve_volume && measured.delta() != 0.0) {
+  // change (measured over the faces the insertion replaced) is given back to the new vertex
+  // (tin.conserve_volume, the default).
+  if (spec_.conserve_volume && change != 0.0) {
     const double area = vertex_area(v);
-    if (area > 0.0) set_z(v, v->point().z() - measured.delta() / area);
+    if (area > 0.0) set_z(v, v->point().z() - change / area);
   }
   touch_with_neighbours(v);
   return v;

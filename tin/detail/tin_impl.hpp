@@ -159,8 +159,17 @@ class TinTerrain final : public Terrain {
   bool on_border(const Vec2& p) const;
   // Inserts a vertex at p (snapped onto the border and onto vertices within tin.snap_m) with
   // height z, keeping generation records of a constrained edge it splits. `inserted` tells
-  // whether a new vertex was made.
-  VertexHandle insert_point(const Vec2& p, double z, bool* inserted = nullptr);
+  // whether a new vertex was made; `volume_change`, if given, receives the change of the
+  // integral of z the insertion made (its Delaunay flips), measured over the faces it
+  // replaced (conflict_region) and the new vertex's star: O(star), where a capture of the
+  // surroundings costs O(region).
+  VertexHandle insert_point(const Vec2& p, double z, bool* inserted = nullptr, double* volume_change = nullptr);
+  // The finite faces an insertion of q (located at `loc`) replaces -- those whose circumcircle
+  // contains q, reached without crossing a constrained edge (the faces on both sides of the
+  // edge q lies on) -- with their integral of z and area. CGAL's flips after an insertion
+  // replace exactly these (its test_conflict, with the same perturbed in-circle predicate).
+  // O(region).
+  void conflict_region(const Point& q, const Location& loc, double& volume, double& area);
   // Removes an unconstrained, non-border vertex, keeping the lists and the hint valid.
   void remove_vertex(VertexHandle v);
   void constrain(VertexHandle a, VertexHandle b, std::uint32_t generation);
