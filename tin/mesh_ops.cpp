@@ -119,9 +119,10 @@ double TinTerrain::height(const Vec2& p) const {
   return interpolate(loc.face, q);
 }
 
-void TinTerrain::conflict_region(const Point& q, const Location& loc, double& volume, double& area) {
+void TinTerrain::conflict_region(const Point& q, const Location& loc, double& volume, double& area, double& extent2) {
   volume = 0.0;
   area = 0.0;
+  Aabb2 box{xy(q), xy(q)};
   const std::uint32_t in = next_face_epoch();
   const std::uint32_t out = next_face_epoch();
   face_scratch_.clear();
@@ -136,6 +137,7 @@ void TinTerrain::conflict_region(const Point& q, const Location& loc, double& vo
     const FaceHandle f = face_scratch_[k];
     volume += face_volume(f);
     area += face_area(f);
+    for (int i = 0; i < 3; ++i) box = united(box, Aabb2{xy(f->vertex(i)), xy(f->vertex(i))});
     for (int i = 0; i < 3; ++i) {
       const FaceHandle n = f->neighbor(i);
       if (f->is_constrained(i) || cdt_.is_infinite(n) || n->info() == in || n->info() == out) continue;
@@ -145,6 +147,7 @@ void TinTerrain::conflict_region(const Point& q, const Location& loc, double& vo
         n->info() = out;
     }
   }
+  extent2 = (box.hi - box.lo).squaredNorm();
 }
 
 VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted, double* volume_change) {
@@ -203,8 +206,8 @@ VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted
       generations_.erase(it);
     }
   }
-  double volume_before = 0.0, area_before = 0.0;
-  if (volume_change) conflict_region(Point(p.x(), p.y(), z), loc, volume_before, area_before);
+  double volume_before = 0.0, area_before = 0.0, extent2 = 0.0;
+  if (volume_change) conflict_region(Point(p.x(), p.y(), z), loc, volume_before, area_before, extent2);
   const VertexHandle v = cdt_.insert(Point(p.x(), p.y(), z), loc.type, loc.face, loc.index);
   if (volume_change) {
     // The new star covers what the replaced faces covered; if not, an assumption broke:
@@ -216,7 +219,10 @@ VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted
       volume_after += face_volume(c);
       area_after += face_area(c);
     } while (++c != done);
-    if (std::abs(area_after - area_before) > 1e-9 * std::max(area_before, 1e-30))
+    // Rounding of the faces' areas is relative to their size (a sliver's area can come out
+    // wrong by percents): the tolerance is relative to the region's squared extent, as the
+    // capture's was to its region's area.
+    if (std::abs(area_after - area_before) > 1e-9 * std::max(area_before, extent2))
       ++capture_mismatches_;
     else
       *volume_change = volume_after - volume_before;

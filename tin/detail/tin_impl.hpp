@@ -166,10 +166,10 @@ class TinTerrain final : public Terrain {
   VertexHandle insert_point(const Vec2& p, double z, bool* inserted = nullptr, double* volume_change = nullptr);
   // The finite faces an insertion of q (located at `loc`) replaces -- those whose circumcircle
   // contains q, reached without crossing a constrained edge (the faces on both sides of the
-  // edge q lies on) -- with their integral of z and area. CGAL's flips after an insertion
-  // replace exactly these (its test_conflict, with the same perturbed in-circle predicate).
-  // O(region).
-  void conflict_region(const Point& q, const Location& loc, double& volume, double& area);
+  // edge q lies on) -- with their integral of z, area, and squared bounding-box diagonal.
+  // CGAL's flips after an insertion replace exactly these (its test_conflict, with the same
+  // perturbed in-circle predicate). O(region).
+  void conflict_region(const Point& q, const Location& loc, double& volume, double& area, double& extent2);
   // Removes an unconstrained, non-border vertex, keeping the lists and the hint valid.
   void remove_vertex(VertexHandle v);
   void constrain(VertexHandle a, VertexHandle b, std::uint32_t generation);
