@@ -192,14 +192,11 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
           if (transfer_scratch_[k] <= 0.0 || nbr_scratch_[k].area <= 0.0) continue;
           const VertexHandle w = vertex_scratch_[k];
           set_z(w, w->point().z() + transfer_scratch_[k] / nbr_scratch_[k].area);
-          // One ring here too (w only): w's neighbours read w's height in their fan gradients,
-          // but w's rise makes their drops towards w smaller, and a neighbour that only the
-          // changed gradient tips over waits until it is touched again (when w gives, or
-          // another neighbour). Measured against touching w's ring at once: 7-10 % fewer
-          // updates on trench, pile and dunes, 19 % fewer settling a tool deeper than the bed
-          // (flat_stroke, tool.depth_m = 0.2), all settled (max slope excess below the
-          // tolerance), walls and flanks within the scatter that rounding changes give.
-          touch(w);
+          // The gradient rule reads w's height in its neighbours' fan gradients too.
+          if (rule.needs_gradient())
+            touch_with_neighbours(w);
+          else
+            touch(w);
           add_to_simplify(w);
           ++report.transfers;
         }
