@@ -268,9 +268,12 @@ class TinTerrain final : public Terrain {
   // erosion.cpp: splits edge (a, b) at its middle (volume change measured, and compensated
   // under tin.conserve_volume); returns the vertex there.
   VertexHandle split_edge(VertexHandle a, VertexHandle b, bool* inserted);
-  // v's neighbours (vertex_scratch_) with heights, distances and areas (nbr_scratch_); returns
-  // v's area.
+  // v's neighbours (the first ring_n_ of vertex_scratch_) with heights, distances and areas
+  // (of nbr_scratch_: nbrs()); returns v's area.
   double gather_neighbours(VertexHandle v);
+  std::span<const ErosionNeighbour> nbrs() const { return {nbr_scratch_.data(), ring_n_}; }
+  std::span<double> transfers() { return {transfer_scratch_.data(), ring_n_}; }
+  std::size_t ring_n_ = 0;
   // Splits v's edges longer than refine_m_ until none is left that may be split (a constrained
   // edge only where its middle is exactly on it, no edge whose middle a facing vertex crowds);
   // returns the number of splits.
