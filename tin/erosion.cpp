@@ -30,9 +30,17 @@ double TinTerrain::gather_neighbours(VertexHandle v) {
   const Point& p = v->point();
   // The hottest loop of a step: the ring comes from the cache (its walk is repeated only when
   // v's star changed), heights and areas are read fresh.
+  // The scratch vectors only grow (a resize per visit costs more than the visit's arithmetic):
+  // ring_n_ of their entries are v's.
   const std::span<const VertexHandle> ring = ring_of(v);
-  vertex_scratch_.assign(ring.begin(), ring.end());
-  nbr_scratch_.resize(ring.size());
+  ring_n_ = ring.size();
+  // (vertex_scratch_ apart: the stamp collects vertices in it.)
+  if (vertex_scratch_.size() < ring_n_) vertex_scratch_.resize(ring_n_);
+  if (nbr_scratch_.size() < ring_n_) {
+    nbr_scratch_.resize(ring_n_);
+    transfer_scratch_.resize(ring_n_);
+  }
+  std::copy(ring.begin(), ring.end(), vertex_scratch_.begin());
   for (std::size_t k = 0; k < ring.size(); ++k) {
     const Point& q = ring[k]->point();
     const double ex = q.x() - p.x(), ey = q.y() - p.y();
@@ -43,18 +51,15 @@ double TinTerrain::gather_neighbours(VertexHandle v) {
 
 VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* inserted) {
   const Vec2 m = 0.5 * (xy(a) + xy(b));
-  // The faces whose circumcircle meets a box of a quarter of the edge around its middle: a box of
-  // a few snap lengths around it once missed a face that the insertion changed (a 37 mm edge, in
-  // TinStress.RandomStrokes), and the volume give-back needs every changed face.
-  Capture capture = begin_capture(Aabb2{m, m}.expanded(0.25 * (xy(a) - xy(b)).norm()));
-  const VertexHandle v = insert_point(m, height(m), inserted);
-  const CaptureResult measured = end_capture(capture);
+  double change = 0.0;
+  const VertexHandle v = insert_point(m, height(m), inserted, &change);
   if (!*inserted) return v;
   // The split itself keeps the surface; the Delaunay flips after it may not: their volume
-  // change is given back to the new vertex (tin.conserve_volume, the default).
-  if (spec_.conserve_volume && measured.delta() != 0.0) {
+  // change (measured over the faces the insertion replaced) is given back to the new vertex
+  // (tin.conserve_volume, the default).
+  if (spec_.conserve_volume && change != 0.0) {
     const double area = vertex_area(v);
-    if (area > 0.0) set_z(v, v->point().z() - measured.delta() / area);
+    if (area > 0.0) set_z(v, v->point().z() - change / area);
   }
   touch_with_neighbours(v);
   return v;
@@ -106,7 +111,7 @@ bool TinTerrain::refine_crease(VertexHandle v) {
   // Facet k is (v, ring[k], ring[k + 1]) (the ring is counter-clockwise); edge (v, ring[k])
   // lies between facets k - 1 and k. A pair spanning 180 degrees or more (a border vertex's
   // gap) forms no facet, and its edges are not creases.
-  const std::size_t n = nbr_scratch_.size();
+  const std::size_t n = ring_n_;
   if (n < 3) return false;
   const double z = v->point().z();
   const auto facet_gradient = [&](std::size_t k, Vec2& g) {
@@ -151,33 +156,31 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
   // The gradient rule's input: the area-weighted facet gradients of v's star (gather_neighbours
   // lists the neighbours counter-clockwise, so consecutive ones span v's triangles).
   const auto gradient_at = [&](VertexHandle v) {
-    return rule.needs_gradient() ? fan_gradient(v->point().z(), nbr_scratch_) : SurfaceGradient{};
+    return rule.needs_gradient() ? fan_gradient(v->point().z(), nbrs()) : SurfaceGradient{};
   };
   for (int pass = 0; pass < budget.max_passes && !erosion_list_.empty() && report.updates < budget.max_updates;
        ++pass) {
     ++report.passes;
-    work.clear();
-    for (const ErosionEntry& e : erosion_list_) work.push_back(e.vertex);
+    work.resize(erosion_list_.size());
+    for (std::size_t k = 0; k < work.size(); ++k) work[k] = erosion_list_[k].vertex;
     for (VertexHandle v : work) {
       if (report.updates >= budget.max_updates) break;
       if (v->info().erosion_slot == kNoSlot) continue;
       ++report.updates;
       double area = gather_neighbours(v);
-      transfer_scratch_.resize(nbr_scratch_.size());
-      double total = erosion_transfers(v->point().z(), area, gradient_at(v), nbr_scratch_, rule, transfer_scratch_,
-                                       NeighbourLayout::Fan);
+      double total =
+          erosion_transfers(v->point().z(), area, gradient_at(v), nbrs(), rule, transfers(), NeighbourLayout::Fan);
       // Sand moving between vertices with long edges would spread over far-reaching
       // triangles: refine the stars of the giver and the receivers first, then recompute.
       for (int round = 0; round < 3 && total > 0.0; ++round) {
         std::size_t splits = refine_around(v);
-        for (std::size_t k = 0; k < nbr_scratch_.size(); ++k)
+        for (std::size_t k = 0; k < ring_n_; ++k)
           if (transfer_scratch_[k] > 0.0) splits += refine_around(vertex_scratch_[k]);
         if (splits == 0 && fine_m_ < refine_m_ && refine_crease(v)) splits = 1;
         if (splits == 0) break;
         area = gather_neighbours(v);
-        transfer_scratch_.resize(nbr_scratch_.size());
-        total = erosion_transfers(v->point().z(), area, gradient_at(v), nbr_scratch_, rule, transfer_scratch_,
-                                  NeighbourLayout::Fan);
+        total =
+            erosion_transfers(v->point().z(), area, gradient_at(v), nbrs(), rule, transfers(), NeighbourLayout::Fan);
       }
       // Settling criterion (slope excess): the rule moves nothing where every slope is below
       // tan_settle (erosion.settle_tolerance_deg above critical); a transfer removes a fixed
@@ -189,9 +192,9 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
         // only its own drops grow (its neighbours' drops towards it shrank).
         // (vertex_scratch_ holds v's neighbours: no second circulation.)
         touch(v);
-        for (VertexHandle w : vertex_scratch_) touch(w);
+        for (std::size_t k = 0; k < ring_n_; ++k) touch(vertex_scratch_[k]);
         add_to_simplify(v);
-        for (std::size_t k = 0; k < nbr_scratch_.size(); ++k) {
+        for (std::size_t k = 0; k < ring_n_; ++k) {
           if (transfer_scratch_[k] <= 0.0 || nbr_scratch_[k].area <= 0.0) continue;
           const VertexHandle w = vertex_scratch_[k];
           set_z(w, w->point().z() + transfer_scratch_[k] / nbr_scratch_[k].area);

@@ -119,7 +119,39 @@ double TinTerrain::height(const Vec2& p) const {
   return interpolate(loc.face, q);
 }
 
-VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted) {
+void TinTerrain::conflict_region(const Point& q, const Location& loc, double& volume, double& area, double& extent2) {
+  volume = 0.0;
+  area = 0.0;
+  Aabb2 box{xy(q), xy(q)};
+  const std::uint32_t in = next_face_epoch();
+  const std::uint32_t out = next_face_epoch();
+  face_scratch_.clear();
+  const auto take = [&](FaceHandle f) {
+    if (cdt_.is_infinite(f) || f->info() == in) return;
+    f->info() = in;
+    face_scratch_.push_back(f);
+  };
+  take(loc.face);
+  if (loc.type == Cdt::EDGE) take(loc.face->neighbor(loc.index));
+  for (std::size_t k = 0; k < face_scratch_.size(); ++k) {
+    const FaceHandle f = face_scratch_[k];
+    volume += face_volume(f);
+    area += face_area(f);
+    for (int i = 0; i < 3; ++i) box = united(box, Aabb2{xy(f->vertex(i)), xy(f->vertex(i))});
+    for (int i = 0; i < 3; ++i) {
+      const FaceHandle n = f->neighbor(i);
+      if (f->is_constrained(i) || cdt_.is_infinite(n) || n->info() == in || n->info() == out) continue;
+      if (cdt_.side_of_oriented_circle(n, q, true) == CGAL::ON_POSITIVE_SIDE)
+        take(n);
+      else
+        n->info() = out;
+    }
+  }
+  extent2 = (box.hi - box.lo).squaredNorm();
+}
+
+VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted, double* volume_change) {
+  if (volume_change) *volume_change = 0.0;
   if (inserted) *inserted = false;
   if (!std::isfinite(p_in.x()) || !std::isfinite(p_in.y()) || !std::isfinite(z))
     throw InputError("tin: a vertex must have finite coordinates");
@@ -174,7 +206,27 @@ VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted
       generations_.erase(it);
     }
   }
+  double volume_before = 0.0, area_before = 0.0, extent2 = 0.0;
+  if (volume_change) conflict_region(Point(p.x(), p.y(), z), loc, volume_before, area_before, extent2);
   const VertexHandle v = cdt_.insert(Point(p.x(), p.y(), z), loc.type, loc.face, loc.index);
+  if (volume_change) {
+    // The new star covers what the replaced faces covered; if not, an assumption broke:
+    // report no change rather than a wrong one (as end_capture does).
+    double volume_after = 0.0, area_after = 0.0;
+    auto c = cdt_.incident_faces(v), done = c;
+    do {
+      if (cdt_.is_infinite(c)) continue;
+      volume_after += face_volume(c);
+      area_after += face_area(c);
+    } while (++c != done);
+    // Rounding of the faces' areas is relative to their size (a sliver's area can come out
+    // wrong by percents): the tolerance is relative to the region's squared extent, as the
+    // capture's was to its region's area.
+    if (std::abs(area_after - area_before) > 1e-9 * std::max(area_before, extent2))
+      ++capture_mismatches_;
+    else
+      *volume_change = volume_after - volume_before;
+  }
   v->info() = VertexInfo{};
   v->info().border = on_border(p) ? 1 : 0;
   hull_vertices_ += v->info().border;

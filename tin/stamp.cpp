@@ -467,19 +467,28 @@ void TinTerrain::remove_redundant(StampWork& w, StampReport& report) {
 double TinTerrain::deposit_on_rim(StampWork& w, double deposit, StampReport& report) {
   // Weighted by the common rule. The band's vertices first get short edges (refine_around),
   // so the sand stays in the band.
+  // A weight costs O(footprint corners): each vertex's is computed once, kept by address for
+  // the second collection (which adds the refinement's vertices), looked up, never iterated.
   const Aabb2 band_box = intersection(w.tool.influence_bounds(), box_);
   collect_vertices(band_box, vertex_scratch_);
   std::vector<VertexHandle> band_vertices;
-  for (VertexHandle v : vertex_scratch_)
-    if (w.rim_weight(xy(v)) > 0.0) band_vertices.push_back(v);
+  std::vector<std::pair<const void*, double>> known;
+  known.reserve(vertex_scratch_.size());
+  for (VertexHandle v : vertex_scratch_) {
+    known.emplace_back(&*v, w.rim_weight(xy(v)));
+    if (known.back().second > 0.0) band_vertices.push_back(v);
+  }
+  std::sort(known.begin(), known.end());
   for (VertexHandle v : band_vertices) report.vertices_inserted += refine_around(v);
   collect_vertices(band_box, vertex_scratch_);
   std::vector<std::pair<VertexHandle, double>> targets;
   double weight_sum = 0.0;
   for (VertexHandle v : vertex_scratch_) {
-    const double weight = w.rim_weight(xy(v));
+    const auto it = std::lower_bound(known.begin(), known.end(), std::pair<const void*, double>(&*v, -HUGE_VAL));
+    const double weight = it != known.end() && it->first == &*v ? it->second : w.rim_weight(xy(v));
     if (weight <= 0.0) continue;
-    const double wa = weight * vertex_area(v);
+    // (The stamp forgot the region's cached areas before this, and the refinement its stars'.)
+    const double wa = weight * cached_area(v);
     targets.emplace_back(v, wa);
     weight_sum += wa;
   }
@@ -493,7 +502,7 @@ double TinTerrain::deposit_on_rim(StampWork& w, double deposit, StampReport& rep
   }
   if (!(weight_sum > 0.0) || deposit == 0.0) return 0.0;
   for (const auto& [v, wa] : targets) {
-    const double a = vertex_area(v);
+    const double a = cached_area(v);
     if (a <= 0.0) continue;
     set_z(v, v->point().z() + deposit * (wa / weight_sum) / a);
     w.changed.push_back(v);
@@ -586,7 +595,7 @@ StampReport TinTerrain::pour(const ToolStamp& s) {
     weight_sum += wa;
   }
   for (const auto& [v, wa] : targets) {
-    const double a = vertex_area(v);
+    const double a = cached_area(v);
     if (a <= 0.0) continue;
     set_z(v, v->point().z() + volume * (wa / weight_sum) / a);
     touch_with_neighbours(v);

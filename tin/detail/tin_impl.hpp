@@ -159,8 +159,17 @@ class TinTerrain final : public Terrain {
   bool on_border(const Vec2& p) const;
   // Inserts a vertex at p (snapped onto the border and onto vertices within tin.snap_m) with
   // height z, keeping generation records of a constrained edge it splits. `inserted` tells
-  // whether a new vertex was made.
-  VertexHandle insert_point(const Vec2& p, double z, bool* inserted = nullptr);
+  // whether a new vertex was made; `volume_change`, if given, receives the change of the
+  // integral of z the insertion made (its Delaunay flips), measured over the faces it
+  // replaced (conflict_region) and the new vertex's star: O(star), where a capture of the
+  // surroundings costs O(region).
+  VertexHandle insert_point(const Vec2& p, double z, bool* inserted = nullptr, double* volume_change = nullptr);
+  // The finite faces an insertion of q (located at `loc`) replaces -- those whose circumcircle
+  // contains q, reached without crossing a constrained edge (the faces on both sides of the
+  // edge q lies on) -- with their integral of z, area, and squared bounding-box diagonal.
+  // CGAL's flips after an insertion replace exactly these (its test_conflict, with the same
+  // perturbed in-circle predicate). O(region).
+  void conflict_region(const Point& q, const Location& loc, double& volume, double& area, double& extent2);
   // Removes an unconstrained, non-border vertex, keeping the lists and the hint valid.
   void remove_vertex(VertexHandle v);
   void constrain(VertexHandle a, VertexHandle b, std::uint32_t generation);
@@ -259,9 +268,12 @@ class TinTerrain final : public Terrain {
   // erosion.cpp: splits edge (a, b) at its middle (volume change measured, and compensated
   // under tin.conserve_volume); returns the vertex there.
   VertexHandle split_edge(VertexHandle a, VertexHandle b, bool* inserted);
-  // v's neighbours (vertex_scratch_) with heights, distances and areas (nbr_scratch_); returns
-  // v's area.
+  // v's neighbours (the first ring_n_ of vertex_scratch_) with heights, distances and areas
+  // (of nbr_scratch_: nbrs()); returns v's area.
   double gather_neighbours(VertexHandle v);
+  std::span<const ErosionNeighbour> nbrs() const { return {nbr_scratch_.data(), ring_n_}; }
+  std::span<double> transfers() { return {transfer_scratch_.data(), ring_n_}; }
+  std::size_t ring_n_ = 0;
   // Splits v's edges longer than refine_m_ until none is left that may be split (a constrained
   // edge only where its middle is exactly on it, no edge whose middle a facing vertex crowds);
   // returns the number of splits.
