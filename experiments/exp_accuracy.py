@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Accuracy against time: pile, crater and trench on both back-ends over resolution sweeps
-(grid cell size with 4 and 8 neighbours; TIN tool polygon sides, contour subdivision and
-erosion refinement), each with both erosion rules (`edge`, the paper's; `gradient`), time per
-step against error on one set of axes, Pareto fronts marked. The trench is dug at several
+(grid cell size with 4 and 8 neighbours; TIN tool polygon sides, contour subdivision, erosion
+refinement and curvature refinement), each with both erosion rules (`edge`, the paper's;
+`gradient`), time per step against error on one set of axes, Pareto fronts marked. The trench is dug at several
 azimuths and scored by its worst one, so no stencil is judged on its best direction only."""
 import math
 
@@ -39,7 +39,7 @@ def sweeps(profile_name, case):
     grid += [(f"sparse {c * 1000:g} mm 8-nb", "sparse", [f"grid.cell_m={c}", "grid.neighbours=8"]) for c in cells]
     sides = {"tiny": [16, 32], "paper": [16, 32, 64], "full": [16, 32, 64, 128]}[profile_name]
     # A 1 mm refinement makes the TIN trench take minutes; it is in the full profile only.
-    refine = {"tiny": [0.0], "paper": [0.0, 0.002], "full": [0.0, 0.002, 0.001]}[profile_name]
+    refine = {"tiny": [0.0], "paper": [0.0, 0.004, 0.002], "full": [0.0, 0.004, 0.002, 0.001]}[profile_name]
     tin = []
     if case == "crater":
         # The TIN stamps a convex tool with as many corners as its mesh resolves (about one per
@@ -53,6 +53,10 @@ def sweeps(profile_name, case):
     if case != "crater":
         tin += [(f"tin refine {r * 1000:g} mm" if r > 0 else "tin refine default", "tin", [f"tin.refine_m={r}"])
                 for r in refine]
+        # Refinement where facet gradients jump (the apex, the toe, a trench's edges), at the
+        # default edge length elsewhere: the TIN's own way to spend vertices on accuracy.
+        if profile_name != "tiny":
+            tin += [("tin curved 0.3 mm", "tin", ["tin.curvature_tolerance_m=0.0003"])]
     return grid + tin
 
 
