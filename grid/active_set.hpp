@@ -121,22 +121,28 @@ class BasicActiveSet {
   // visit and leaves after idle_passes in a row. `centres` holds rows y0..y1 (words_per_row()
   // words each, padding clear), and every member lies in rows y0..y1 before the call. (A
   // sweep differs only for a node activated before its own idle visit: it starts at 1, here
-  // at 0.) The dense erosion pass keeps the set this way. O(words of rows y0 - 1..y1 + 1 +
-  // members).
-  void assign_blocks(const std::vector<std::uint64_t>& centres, std::size_t y0, std::size_t y1) {
+  // at 0.) The dense erosion pass keeps the set this way. `x0`..`x1`: columns that hold every
+  // member and every centre of those rows (the words outside them, widened by the blocks'
+  // column, are left alone: nothing changes there). O(words of columns x0 - 1..x1 + 1 of rows
+  // y0 - 1..y1 + 1 + members).
+  void assign_blocks(const std::vector<std::uint64_t>& centres, std::size_t y0, std::size_t y1, std::size_t x0 = 0,
+                     std::size_t x1 = ~std::size_t{0}) {
     const std::size_t W = words_per_row_;
     const unsigned tail = static_cast<unsigned>(nx_ % 64);
     const std::uint64_t last_mask = tail == 0 ? ~std::uint64_t{0} : (std::uint64_t{1} << tail) - 1;
     const std::size_t ya = y0 > 0 ? y0 - 1 : 0, yb = y1 + 1 < ny_ ? y1 + 1 : y1;
+    const std::size_t wa = x0 > 0 ? (x0 - 1) / 64 : 0, wb = (x1 < nx_ - 1 ? x1 + 1 : nx_ - 1) / 64;
     const auto centre = [&](std::size_t y, std::size_t w) {
       return y >= y0 && y <= y1 ? centres[(y - y0) * W + w] : std::uint64_t{0};
     };
     std::vector<std::uint64_t> rows(W + 2, 0);  // centres of rows y - 1..y + 1, ored; a clear word each side
     for (std::size_t y = ya; y <= yb; ++y) {
-      std::uint32_t count = 0;
-      for (std::size_t w = 0; w < W; ++w)
+      std::uint32_t count = row_count_[y];
+      for (std::size_t w = wa; w <= wb; ++w) {
         rows[w + 1] = centre(y, w) | (y > 0 ? centre(y - 1, w) : 0) | (y + 1 < ny_ ? centre(y + 1, w) : 0);
-      for (std::size_t w = 0; w < W; ++w) {
+        count -= static_cast<std::uint32_t>(bits_in_word(bits_[y * W + w]));
+      }
+      for (std::size_t w = wa; w <= wb; ++w) {
         // Rows y - 1, y, y + 1, then one column each way (bits carried across words).
         const std::uint64_t m = rows[w + 1];
         std::uint64_t d = m | (m << 1) | (rows[w] >> 63) | (m >> 1) | (rows[w + 2] << 63);

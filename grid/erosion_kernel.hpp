@@ -27,9 +27,11 @@
 //   void activate_block(std::size_t ix, std::size_t iy);  // node and its 3 x 3 block
 //   Spans spans() const; bool row_span(y, x0&, x1&) const; unsigned next_sweep();
 //   std::size_t words_per_row() const;
-//   void assign_blocks(centres, y0, y1);  // the dense pass's bookkeeping
+//   void assign_blocks(centres, y0, y1, x0, x1);  // the dense pass's bookkeeping
 // Node indices are those of the GridLayout (k = iy * nx + ix); a sparse store maps them to
-// its own coordinates.
+// its own coordinates. A store may also offer data() (contiguous heights, HeightGrid), or
+// read_row / write_changed (SparseHeights: the dense pass then runs each row on a
+// RowWindow, grid/row_window.hpp, a contiguous copy of the three rows it touches).
 //
 // Conservation. Each transfer V from i to j writes z_j + V / A_j and takes the same V
 // from the centre: A_i dz_i = -sum_j A_j dz_j up to the rounding of the stored heights.
@@ -86,21 +88,25 @@
 // neighbour, plus per transfer one division, and a store per receiving neighbour and one
 // for the centre (visits in vector lanes write every slot: no branch per slot); the
 // gradient rule adds a square root and a division per visit. Measured with AVX-512 (Zen 4,
-// tests/bench/grid_bench.cpp, edge rule, 8 neighbours, CPU time, medians of three runs
-// interleaved with the build before the AVX-512 lanes), M updates/s (an update: one node of
-// a span or one active-set visit): double 79 on the pile (before: 64), 121 on the stroke
-// (81), 155 with every node of 2048^2 active (104; 10.5x the plain scalar sweep in the same
-// runs, before 7.5x); float 40 (40), 58 (47), 86 (71); the gradient rule (AVX-512 lanes
-// only; AVX2 visits it one node at a time), double: 54 on the pile and 79 on the stroke
-// (one node at a time: 21 and 24). Measured in the AVX2 lanes
-// (callgrind, which runs no AVX-512), instructions per update, double / float, now (before
-// the group bookkeeping; before the three phases and the AVX2 lanes): every node of 2048^2
-// active 107 double (111 / 150; 175 / 208), grid_bench's pile 212 / 271 (222 / 281; 307 /
-// 363), its stroke 150 / 203 (160 / 213; 243 / 289). Four visits in AVX2 lanes take ~320 instructions
-// (double); classing a row ~16 per node (AVX2, double; ~29 float); rebuilding the active set
-// after a dense pass ~8 per node of the rows. Active-set visits add ~100 for the set's
-// bookkeeping. Float costs more than its instructions: the rounding carry chains every
-// transferring visit to the one before (float gains least from the wider lanes).
+// tests/bench/grid_bench.cpp, edge rule, 8 neighbours, CPU time, medians of five runs
+// interleaved with the build before the bookkeeping was inlined and cut to the visited
+// columns), M updates/s (an update: one node of a span or one active-set visit): double 90
+// on the pile (before: 83), 135 on the stroke (128), 162 with every node of 2048^2 active
+// (164; 10.8x the plain scalar sweep in the same runs); float 45 (43), 61 (58), 87 (84); the
+// gradient rule (AVX-512 lanes only; AVX2 visits it one node at a time), double: 60 on the
+// pile and 87 on the stroke (57, 83). Measured in the AVX2 lanes (callgrind, which runs no
+// AVX-512), instructions per update, double / float, now (before): grid_bench's pile 199 /
+// 259 (211 / 270), its stroke 141 / 194 (150 / 202); every node of 2048^2 active ~107
+// double. Four visits in AVX2 lanes take ~320 instructions (double); classing a row ~16
+// per node (AVX2, double; ~29 float); rebuilding the active set after a dense pass ~8 per
+// node of the visited columns. Active-set visits add ~100 for the set's bookkeeping. Float
+// costs more than its instructions: the rounding carry chains every transferring visit to
+// the one before (float gains least from the wider lanes). Where the time goes with
+// AVX-512 (perf, sampled): on the pile, ~45 % in the eight-node visits, ~30 % in the pass's
+// bookkeeping (phases, flags, the set's rebuild), ~10 % classing; with every node active,
+// ~53 % visits, ~24 % classing, ~22 % bookkeeping. The sparse grid runs the same paths on a
+// RowWindow (row_window.hpp): three rows copied in and the changed heights written back per
+// row, O(span) each.
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -110,6 +116,7 @@
 #include <cstring>
 #include <limits>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "common/erosion.hpp"
@@ -117,6 +124,7 @@
 #include "grid/erosion_lanes_avx512.hpp"
 #include "grid/grid_layout.hpp"
 #include "grid/row_bits.hpp"
+#include "grid/row_window.hpp"
 
 // _mm256_movemask_pd, in the AVX2 functions only (compiled for AVX2 by their target attribute).
 #include <immintrin.h>
@@ -476,6 +484,23 @@ inline Lanes lanes_for(SweepPath path) {
   return has_avx2() ? Lanes::Avx2 : Lanes::Sse2;
 }
 
+// The RowWindow a store's dense pass runs its rows on (stores that copy rows), else nothing.
+struct NoWindow {
+  template <class Store>
+  NoWindow(Store&, std::size_t, std::size_t) {}
+};
+template <class Store>
+struct WindowOfStore {
+  using type = NoWindow;
+};
+template <class Store>
+requires requires(Store& s) { s.read_row(0, 0, 0, nullptr); }
+struct WindowOfStore<Store> {
+  using type = RowWindow<Store>;
+};
+template <class Store>
+using WindowOf = typename WindowOfStore<Store>::type;
+
 // One dense pass, in place (Gauss-Seidel), rows in the direction the active set's next
 // sweep would take: in each row, every node from the first to the last member (the row's
 // span) is visited once. Like the active-set sweep it is live: a row's span also covers the
@@ -498,15 +523,14 @@ inline Lanes lanes_for(SweepPath path) {
 // run (along y, rows still follow each other). The order depends only on the active set, so
 // every store computes the same heights.
 //
-// Exactness of the shortcut. On a store with contiguous heights (HeightGrid: data()), a
-// row's interior nodes are first classed by unstable_bits (AVX-512: eight at a time; AVX2:
-// four), after the
-// previous row is done; a node is then visited only if it is flagged, on a border, or within
-// two columns of a node of its row that transferred before it (a visit writes into its 3 x 3
+// Exactness of the shortcut. On a store with contiguous heights (HeightGrid: data(); the
+// sparse grid's RowWindow), a row's interior nodes are first classed by unstable_bits
+// (AVX-512: eight at a time; AVX2: four), after the previous row is done; a node is then visited only if it is flagged,
+// on a border, or within two columns of a node of its row that transferred before it (a visit writes into its 3 x 3
 // block, which a node up to two columns away reads). Its inputs are otherwise those it was
 // classed with, so skipping it is exactly what its visit would have done: the pass gives the
 // same heights, bit for bit, as visiting every node of the spans (which is what it does on
-// other stores, e.g. the sparse grid). `lanes` = Sse2 classes in SSE2 registers and visits
+// stores with neither data() nor read_row). `lanes` = Sse2 classes in SSE2 registers and visits
 // one node at a time, Avx2 four at a time (the same heights; tests compare).
 //
 // Cost: O(span nodes) per pass -- the classing vectorised over the row, one visit per
@@ -521,13 +545,27 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
   const std::size_t words = active.words_per_row();
   // The nodes that transferred, one row of words per visited row in visiting order.
   std::vector<std::uint64_t> moved_bits;
-  constexpr bool kContiguous = requires { store.data(); };
+  moved_bits.reserve((spans.y1 - spans.y0 + 3) * words);  // the members' rows and one each way, as a rule
+  // A store without contiguous heights that copies rows (the sparse grid) runs each row on a
+  // RowWindow of the three rows it touches (node k = nx + ix of the row), as a contiguous
+  // store runs it on its own heights (node k = iy * nx + ix).
+  constexpr bool kWindowed = requires { store.read_row(0, 0, 0, nullptr); };
+  [[maybe_unused]] WindowOf<Store> window(store, nx, ny);
+  auto& rs = [&]() -> auto& {
+    if constexpr (kWindowed)
+      return window;
+    else
+      return store;
+  }
+  ();
+  constexpr bool kContiguous = requires { rs.data(); };
   // The row's unstable nodes, one bit each (plus a word: or_bits may write one past the row).
   std::vector<std::uint64_t> flags(words + 1, 0);
   std::size_t prev_lo = 1, prev_hi = 0;  // span of the previous row's transfers (empty)
   std::size_t visited_rows = 0;
   double moved_sum = moved;  // in visiting order, in a register
   std::size_t transfer_count = 0;
+  std::size_t col_lo = nx, col_hi = 0;  // columns of the visited spans: every member and transfer lies in them
   const std::size_t first = y_up ? spans.y0 : spans.y1;
   for (std::size_t iy = first; iy < ny; iy = y_up ? iy + 1 : iy - 1) {  // iy - 1 wraps below 0: stops
     std::size_t x0 = nx, x1 = 0;
@@ -552,13 +590,16 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     std::fill(flags.begin() + static_cast<std::ptrdiff_t>(x0 / 64),
               flags.begin() + static_cast<std::ptrdiff_t>(x1 / 64 + 2), std::uint64_t{0});
     std::size_t skip_lo = 1, skip_hi = 0;  // nodes classed (empty: none)
+    // The row's first node on the store it runs on.
+    const std::size_t row_k = kWindowed ? nx : iy * nx;
+    if constexpr (kWindowed) window.load(iy, x0 > 0 ? x0 - 1 : 0, std::min(x1 + 1, nx - 1));
     if constexpr (kContiguous) {
       if (iy > 0 && iy + 1 < ny && nx >= 3) {
         skip_lo = std::max<std::size_t>(1, x0);
         skip_hi = std::min(nx - 2, x1);
         if (skip_lo <= skip_hi) {
           const RowThresholds<N> c(middle, t.tan_settle() * t.tan_settle());
-          const auto* row = store.data() + iy * nx;
+          const auto* row = std::as_const(rs).data() + row_k;
           if (lanes == Lanes::Avx512)
             unstable_bits_avx512<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
           else if (lanes == Lanes::Avx2)
@@ -575,7 +616,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       if (x1 > skip_hi) set_bits(must, skip_hi + 1, x1);
     }
     std::size_t row_lo = nx, row_hi = 0;  // span of this row's transfers (empty)
-    const auto transferred = [&](std::size_t ix, const VisitResult& v) {
+    const auto transferred = [&](std::size_t ix, const VisitResult& v) __attribute__((always_inline)) {
       transfer_count += static_cast<std::size_t>(v.transfers);
       moved_sum += v.moved;
       moved_row[ix / 64] |= std::uint64_t{1} << (ix % 64);
@@ -585,7 +626,8 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     };
     // The same for the nodes a + 3 l of a group whose lanes l (bits of b) transferred, at once
     // (volumes added in visiting order).
-    const auto group_transferred = [&](std::size_t a, unsigned b, const double* given, std::size_t transfers) {
+    const auto group_transferred = [&](std::size_t a, unsigned b, const double* given, std::size_t transfers)
+        __attribute__((always_inline)) {
       for (unsigned rest = b; rest != 0;) {
         const int l = x_up ? std::countr_zero(rest) : 31 - std::countl_zero(rest);
         rest &= ~(1u << l);
@@ -599,8 +641,9 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       row_hi = std::max(row_hi, a + 3 * static_cast<std::size_t>(31 - std::countl_zero(b)));
     };
     const auto visit = [&](std::size_t ix) __attribute__((flatten)) {  // the store's reads and writes inlined
+      if constexpr (kWindowed) window.extend(ix > 0 ? ix - 1 : 0, std::min(ix + 1, nx - 1));  // the span grew
       const VisitResult v =
-          erosion_visit<N, Gradient>(store, t, iy * nx + ix, ix < 2 || ix + 2 >= nx ? t.of(ix, iy) : middle);
+          erosion_visit<N, Gradient>(rs, t, row_k + ix, ix < 2 || ix + 2 >= nx ? t.of(ix, iy) : middle);
       if (v.transfers > 0) transferred(ix, v);
     };
     // Three phases, one per column modulo 3, each in the sweep's direction; on a contiguous
@@ -626,7 +669,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
             double given[8];
             std::size_t transfers = 0;
             if (const unsigned b =
-                    erosion_visit8<N, Gradient>(store, t, nx, iy * nx + a, count, middle, !x_up, given, transfers))
+                    erosion_visit8<N, Gradient>(rs, t, nx, row_k + a, count, middle, !x_up, given, transfers))
               group_transferred(a, b, given, transfers);
             const std::size_t last = x_up ? a + 3 * (count - 1) : a;
             if (x_up ? last >= x1 : last <= x0) break;
@@ -636,7 +679,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
           if (in_groups && lanes == Lanes::Avx2 && lowest >= four_lo && lowest + 9 <= four_hi) {
             double given[4];
             std::size_t transfers = 0;
-            if (const unsigned b = erosion_visit4<N>(store, t, iy * nx + lowest, middle, !x_up, given, transfers))
+            if (const unsigned b = erosion_visit4<N>(rs, t, row_k + lowest, middle, !x_up, given, transfers))
               group_transferred(lowest, b, given, transfers);
             const std::size_t last = x_up ? lowest + 9 : lowest;
             if (x_up ? last >= x1 : last <= x0) break;
@@ -655,7 +698,9 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     } else {
       while (x0 > 0 && bit_at(moved_row, x0)) visit(--x0);
     }
+    if constexpr (kWindowed) window.store_back();
     report.updates += x1 - x0 + 1;
+    col_lo = std::min(col_lo, x0), col_hi = std::max(col_hi, x1);
     if (row_lo <= row_hi) prev_lo = row_lo, prev_hi = row_hi;
   }
   // Rows in increasing y for the set.
@@ -665,7 +710,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       std::swap_ranges(moved_bits.begin() + static_cast<std::ptrdiff_t>(a * words),
                        moved_bits.begin() + static_cast<std::ptrdiff_t>((a + 1) * words),
                        moved_bits.begin() + static_cast<std::ptrdiff_t>(b * words));
-  active.assign_blocks(moved_bits, std::min(first, last), std::max(first, last));
+  active.assign_blocks(moved_bits, std::min(first, last), std::max(first, last), col_lo, col_hi);
   moved = moved_sum;
   report.transfers += transfer_count;
 }

@@ -13,12 +13,12 @@ namespace sb::grid {
 inline bool bit_at(const std::uint64_t* bits, std::size_t x) { return (bits[x / 64] >> (x % 64)) & 1u; }
 // Ors the low bits of `m` (at most 8 set) in at bit x (may straddle two words: `bits` must
 // hold the word after x's).
-inline void or_bits(std::uint64_t* bits, std::size_t x, std::uint64_t m) {
+[[gnu::always_inline]] inline void or_bits(std::uint64_t* bits, std::size_t x, std::uint64_t m) {
   bits[x / 64] |= m << (x % 64);
   if (x % 64 > 56) bits[x / 64 + 1] |= m >> (64 - x % 64);
 }
 // Ors the low 32 bits of `m` in at bit x; writes the word after x's only where bits go there.
-inline void or_bits32(std::uint64_t* bits, std::size_t x, std::uint64_t m) {
+[[gnu::always_inline]] inline void or_bits32(std::uint64_t* bits, std::size_t x, std::uint64_t m) {
   bits[x / 64] |= m << (x % 64);
   if (x % 64 > 32)
     if (const std::uint64_t high = m >> (64 - x % 64)) bits[x / 64 + 1] |= high;

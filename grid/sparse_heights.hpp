@@ -44,6 +44,7 @@
 // a leaf O(64) the first time it writes a tile block with another value); height O(1);
 // volume O(nodes); prune O(64 * blocks written since the last prune), plus O(leaves +
 // blocks) when a block became uniform.
+#include <algorithm>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -109,6 +110,24 @@ class SparseHeights {
     return 0.0;
   }
   double& carry() { return carry_.m3(); }
+  // Heights of nodes x0..x1 of row iy, in order, at out[0..x1 - x0] (the kernel's dense pass
+  // runs on such copies, grid/row_window.hpp). O(x1 - x0): a block's row of 8 nodes is
+  // contiguous in its buffer.
+  using value_type = Real;
+  void read_row(std::size_t iy, std::size_t x0, std::size_t x1, Real* out) const {
+    for (std::size_t x = x0; x <= x1;) {
+      const std::size_t n = std::min(kBlock - (x & 7), x1 - x + 1);
+      const Real* from = data_[block_index(x, iy)] + voxel_offset(x, iy);
+      for (std::size_t i = 0; i < n; ++i) out[i] = from[i];
+      out += n, x += n;
+    }
+  }
+  // Stores values[0..x1 - x0] at nodes x0..x1 of row iy where they differ (in bits) from
+  // before[...], as put() would (the values are already rounded: no carry). O(x1 - x0).
+  void write_changed(std::size_t iy, std::size_t x0, std::size_t x1, const Real* values, const Real* before) {
+    for (std::size_t x = x0; x <= x1; ++x, ++values, ++before)
+      if (!same_bits(*values, *before)) store(x, iy, *values);
+  }
 
   double height(const Vec2& p) const { return bilinear_height(*this, p); }
   double volume() const { return trapezoid_volume(*this); }

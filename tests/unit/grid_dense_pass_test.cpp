@@ -16,6 +16,7 @@
 #include <cstring>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "grid/grid_terrain.hpp"
@@ -202,6 +203,35 @@ TEST(DensePassActiveSet, AssignBlocksIsActivateBlockPerCentre) {
     EXPECT_EQ(by_words.size(), 0u);
     by_words.check(problems);
     EXPECT_TRUE(problems.empty()) << ::testing::PrintToString(problems);
+  }
+}
+
+// Given the columns that hold every member and centre, assign_blocks leaves the words outside
+// them alone and gives the same set as over whole rows (ranges starting and ending at word
+// edges, inside words, and at the grid's edges).
+TEST(DensePassActiveSet, AssignBlocksOverColumnsIsOverWholeRows) {
+  const std::size_t nx = 200, ny = 6;
+  for (const auto& [x0, x1] :
+       {std::pair<std::size_t, std::size_t>{60, 140}, {64, 127}, {63, 128}, {0, 199}, {150, 199}}) {
+    ActiveSet whole(nx, ny, 2), ranged(nx, ny, 2);
+    std::vector<std::uint64_t> centres(whole.words_per_row() * ny, 0);
+    std::uint64_t h = 777;
+    for (std::size_t iy = 0; iy < ny; ++iy)
+      for (std::size_t ix = x0; ix <= x1; ++ix) {
+        h = h * 6364136223846793005ull + 1442695040888963407ull;
+        if ((h >> 61) == 0) centres[iy * whole.words_per_row() + ix / 64] |= std::uint64_t{1} << (ix % 64);
+        if ((h >> 58) % 8 == 1) whole.activate(ix, iy), ranged.activate(ix, iy);  // members before the pass
+      }
+    for (int pass = 0; pass < 3; ++pass) {  // fresh blocks, then idle visits
+      whole.assign_blocks(pass == 0 ? centres : std::vector<std::uint64_t>(centres.size(), 0), 0, ny - 1);
+      ranged.assign_blocks(pass == 0 ? centres : std::vector<std::uint64_t>(centres.size(), 0), 0, ny - 1, x0, x1);
+      ASSERT_EQ(ranged.size(), whole.size()) << x0 << ".." << x1 << " pass " << pass;
+      for (std::size_t iy = 0; iy < ny; ++iy)
+        for (std::size_t ix = 0; ix < nx; ++ix) ASSERT_EQ(ranged.contains(ix, iy), whole.contains(ix, iy));
+      std::vector<std::string> problems;
+      ranged.check(problems);
+      EXPECT_TRUE(problems.empty()) << ::testing::PrintToString(problems);
+    }
   }
 }
 

@@ -73,7 +73,8 @@ TEST_P(SparseAgainstDense, SameHeightsBitForBitInLessMemory) {
 INSTANTIATE_TEST_SUITE_P(Shipped, SparseAgainstDense,
                          ::testing::Values(Case{"flat_stroke", {}, 0.2}, Case{"pile", {}, 0.2},
                                            Case{"trench", {}, 0.45}, Case{"dunes", {}, 1.0},
-                                           Case{"flat_stroke", {"grid.storage=\"float\"", "grid.neighbours=4"}, 0.3}),
+                                           Case{"flat_stroke", {"grid.storage=\"float\"", "grid.neighbours=4"}, 0.3},
+                                           Case{"pile", {"grid.storage=\"float\""}, 0.3}),
                          [](const ::testing::TestParamInfo<Case>& info) {
                            return std::string(info.param.scene) + (info.param.overrides.empty() ? "" : "_variant");
                          });
