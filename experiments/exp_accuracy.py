@@ -148,9 +148,11 @@ def run(ctx):
         rows.append([case, label, rule, len(rs), median(r["step_ms.p50"] for r in rs), error_of(case, rs),
                      rs[0].get("reference.max_error_m", ""), "" if angle == float("-inf") else angle,
                      rs[0].get("pile.roundness", ""), max((r["volume_drift_rel"] for r in rs), key=abs),
-                     max(r["max_slope_excess_deg"] for r in rs), max(r["memory_bytes"] for r in rs)])
+                     max(r["max_slope_excess_deg"] for r in rs), max(r["memory_bytes"] for r in rs),
+                     f"{sum(bool(r['settled']) for r in rs)}/{len(rs)}"])
     md = ctx.table("accuracy", ["case", "model", "rule", "azimuths", "step ms p50", "error", "max error m",
-                                "angle deg", "roundness", "drift rel", "slope excess deg", "bytes"], rows)
+                                "angle deg", "roundness", "drift rel", "slope excess deg", "bytes", "runs settled"],
+                   rows)
 
     def pick(case, rule, pred):
         return [(rs, lab) for (c, lab, b, ru, _), rs in zip(index, s) if c == case and ru == rule and pred(lab, b)]
