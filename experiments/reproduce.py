@@ -128,16 +128,27 @@ A comparison is only worth what its weakest contender is. These judgements come 
 interleaved runs made during development (medians on a shared 2-core machine; see the project's closing
 notes); the tables below are this run's.
 
-- **TIN step time on the trench**: was **our code** several times over, now the method. Each stamp
+- **TIN step time on the trench**: was **our code** several times over, now mostly the method. Each stamp
   re-activated its whole re-triangulated region, convex tools kept corners the mesh cannot resolve, contour
   pieces were subdivided far below the refinement length, every erosion visit walked the triangulation for
-  its neighbours, and the walls of passed stamps left vertex pairs under a millimetre apart (tiny areas
-  that throttle every transfer through them; now thinned once the stamp has passed). With those fixed the
-  TIN's trench step fell from 1.24 to 0.95 ms in this round (interleaved medians). The grid, brought to its
-  own limit in the same round (AVX-512 lanes, the gradient rule in them), fell from 0.24 to 0.10 ms, so the
-  ratio went from 5.2x to 9.2x: what remains is the price of a TIN visit (scattered vertex records, a ring,
-  cotangent weights: several grid node visits' time) and of re-triangulating around every stamp, against
-  a grid kernel that visits eight nodes at once: **the method**.
+  its neighbours, the walls of passed stamps left vertex pairs under a millimetre apart (tiny areas that
+  throttle every transfer through them; now thinned once the stamp has passed), and a split measured its
+  volume change over a box of its surroundings (now over the faces the insertion replaced). The TIN's
+  trench step fell from 1.24 ms two rounds ago to 0.79 ms now; the grid's, brought to its own limit, from
+  0.24 to 0.10 ms, so the ratio is 7.7x (interleaved medians, 7 rounds). Where it goes: the TIN needs
+  fewer erosion updates than the grid during the stroke (0.43x on the trench, 0.62x on the pile: the
+  method's advantage, fewer elements), but one update costs 6-14x the grid's (about 100 ns on a settled
+  mesh, 130-240 ns during a stroke with its splits, against 14-28 ns for the grid's eight-lane visits), and
+  a stamp 10-24x (re-triangulating around every pose). A TIN visit reads a ring of scattered vertex records
+  in CGAL's pointer-linked triangulation, computes cotangent weights and a fan gradient, and is about 1,500
+  instructions; the grid's is about 150, vectorised. A compact, index-based mesh could narrow the first
+  factor (**our code**, not attempted); the rest is **the method**.
+- **TIN settling after a deep stroke** (`flat_stroke.toml` with `tool.depth_m = 0.2`, 15x the grid's
+  stroke-and-settle time): the TIN needs 361k settling updates where the grid needs 97k, because the grid
+  settles with a coarse-to-fine cascade and the TIN with fine passes only, whose diffusive tail (the last
+  quarter of the transfers move a median 7 um each) is long: **our code** (no cascade built for the TIN;
+  a coarser TIN by simplification could play the coarse level), not the method. Visiting order does not
+  matter (reversed or height-sorted passes: 276k-335k updates).
 - **TIN pile with the default (gradient) rule**: was **our code**, fixed; what is left is the method at
   this resolution. The pile came out lobed (flank 26.8 degrees, roundness 0.075, RMSE 164 um, 4.7x the
   grid's) although the same sand relaxing from a 35-degree cone ended round: the flow, not the rest state
@@ -146,15 +157,25 @@ notes); the tables below are this run's.
   directions (on a regular lattice triangulated one way the pile came out as a ridge, roundness 0.22); it
   is now shared by conductance times excess height, with cotangent weights on a TIN (transport without a
   preferred direction on any triangulation; the regular lattice: 0.05); (2) vertex pairs under a
-  millimetre apart throttled the flow (above). Now, in this round's interleaved runs: RMSE 56 um (1.6x the
-  grid's 35), flank 29.5 degrees, roundness 0.023, with 339 vertices (0.5x the grid's memory); settling
-  about 3x the grid's. Tried and not kept: per-pair facet gradients, restricting the gradient rule to
-  neighbours within 30 degrees of downhill (the edge rule's pile, but trench walls up to 3.8 degrees
-  steep), rings of vertices around the pour point (roundness 0.021 or 0.068 depending on their spacing).
-  **The method, for the rest**: a piecewise-linear cone on 7 mm edges errs near its apex and toe;
-  refining where facet gradients jump (`tin.curvature_tolerance_m = 0.0003`, "tin curved" in the
-  orientation tables) gives RMSE 42 um (1.2x the grid's), flank 29.8 degrees and roundness 0.017 with 529
-  vertices (0.7x the grid's memory), at about 10x the grid's step time.
+  millimetre apart throttled the flow (above). Now: RMSE 54 um (1.5x the grid's 35), flank 29.5 degrees,
+  roundness 0.022, with 339 vertices (0.5x the grid's memory), step 4.1x the grid's. Where the error is
+  (share of the squared error): flank 48 %, toe 33 %, apex 6 %, outside the pile 14 % (the grid: 58, 39,
+  4, 0); the flank's 0.5-degree deficit alone accounts for 18 um. Outside the pile, a split's volume
+  give-back lowers the new vertex by up to 0.3 mm, leaving pits below the bed where no tool went; spreading
+  it over the new vertex's star removes most of them but left the RMSE unchanged (56-58 um), so it was not
+  kept. **The method, for the rest**: a piecewise-linear cone on 7 mm edges errs near its apex and toe,
+  and the accuracy table's TIN points trade step time for it (4 mm refinement 43 um at 3x the default
+  TIN's step; 2 mm 39 um at 8x; curvature refinement 42 um at 2x), none of them below the grid's curve.
+- **TIN curvature refinement on trenches** (`tin.curvature_tolerance_m = 0.0003`, "tin curved"): **our
+  code, a bug found and not yet fixed**. Eight of its nine trench runs per rule in the orientation table
+  (ridges and the pile settle) end unsettled after the 20,000 settling passes, with facets near 90 degrees: curvature splits between
+  the last stamp's two contour constraints leave chains of nearly collinear vertices whose sliver
+  triangles the constraints keep, and a vertex next to such a sliver has a neighbour of tiny area; the
+  cotangent split's cap (no pair more than f times its excess) then throttles all its transfers to a
+  trickle. Sharing the rest among the other neighbours when a pair is capped (water-filling) settles
+  these runs, but made the pile worse (RMSE 53 -> 71 um, roundness 0.022 -> 0.030 over five
+  settle tolerances); capping the cotangent at that of 1 or 10 degrees did not settle them. Their wall
+  angles in the tables are those of a surface still moving; the default TIN is not affected.
 - **TIN simplification**: was **our code** (the paper's step 3 never removed a vertex on a flat bed), fixed:
   once the terrain is at rest, near-planar vertices are removed (volume kept, no triangle tilted past the
   stable slope), tens per shipped scene; during strokes the paper's alpha_flat rule alone acts.
@@ -168,19 +189,24 @@ notes); the tables below are this run's.
 - **Grid speed**: was **our code**, now near the method's limit in double. The dense pass skips stable
   nodes by bit scans over vector-classed rows and visits up to eight independent nodes at once (columns
   modulo 3; AVX-512 lanes with masked ends, the gradient rule included; AVX2 and SSE2 where the CPU lacks
-  them), bit for bit the scalar visits: on `grid_bench`'s states 79 M updates/s on the pile and 121 M on
-  the stroke (36-51 two rounds ago), 155 M with every node active, 10.5x a plain scalar sweep of the same
-  rule (helper's interleaved medians). What stops it short of memory bandwidth: the in-place
-  (Gauss-Seidel) order that the default transfer fraction needs to stay monotone (a Jacobi or four-colour
-  sweep overshoots at f = 0.5), the permutes that gather a 3 x 3 block per lane, and, in float, the
-  rounding carry that chains every transfer to the one before.
+  them), bit for bit the scalar visits: on `grid_bench`'s states 90 M updates/s on the pile and 136 M on
+  the stroke (36-51 three rounds ago), 169 M with every node of 2048^2 active, 11x a plain scalar sweep of
+  the same rule (interleaved medians, 5 rounds). What stops it short of the 100 M on the pile and 250 M
+  all active it aims at: the in-place (Gauss-Seidel) order that the default transfer fraction needs to
+  stay monotone (a Jacobi or four-colour sweep overshoots at f = 0.5), the permutes that gather a 3 x 3
+  block per lane (36 per group of eight; keeping a row chunk in column layout across the three phases
+  would change the visiting order), and, in float, the rounding carry that chains every transfer to the
+  one before: **the method's order**, and permutes our layout could still save.
 - **Grid settling of large grids**: was **our code**, fixed. Fine passes alone are diffusive (passes grow
   about 3.5x per halving of the cell, time as n^1.9); a coarse-to-fine cascade relaxes 2 x 2 blocks of
   blocks with the same kernel, adds each level's change to its children (exact volume, energy never
   rising) and lets the fine passes finish: see the settling table below for this run's figures.
 - **Sparse grid on the trench** (memory 0.39x the dense grid's, not a fifth): **the method**. Memory
   follows the disturbed area in whole 8 x 8 blocks at 8.6 bytes per node; a long trench disturbs about a
-  quarter of the nodes.
+  quarter of the nodes. Its step was 2-3.5x the dense grid's because its dense pass visited nodes one at a
+  time (**our code**): it now runs each row on a contiguous copy of the three rows it touches, with the
+  dense grid's vector classing and lanes (same heights bit for bit), and costs 1.4-1.7x the dense grid's
+  step on the shipped scenes (pile 0.072 against 0.049 ms, trench 0.17 against 0.10).
 - **4-neighbour grid**: with the edge rule a pile is a diamond and trench walls stand at 39 degrees at 45
   degrees azimuth; the gradient rule removes the trench's anisotropy but leaves piles and planes up to
   2 degrees flatter than critical, because sand cannot leave along the diagonal: **the method's stencil**.
