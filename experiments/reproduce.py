@@ -166,24 +166,23 @@ notes); the tables below are this run's.
   kept. **The method, for the rest**: a piecewise-linear cone on 7 mm edges errs near its apex and toe,
   and the accuracy table's TIN points trade step time for it (4 mm refinement 43 um at 3x the default
   TIN's step; 2 mm 39 um at 8x; curvature refinement 42 um at 2x), none of them below the grid's curve.
-- **TIN curvature refinement on trenches** (`tin.curvature_tolerance_m = 0.0003`, "tin curved"): **our
-  code, a bug found and not yet fixed**. Eight of its nine trench runs per rule in the orientation table
-  (ridges and the pile settle) end unsettled after the 20,000 settling passes, with facets near 90 degrees: curvature splits between
-  the last stamp's two contour constraints leave chains of nearly collinear vertices whose sliver
-  triangles the constraints keep, and a vertex next to such a sliver has a neighbour of tiny area; the
-  cotangent split's cap (no pair more than f times its excess) then throttles all its transfers to a
-  trickle. Sharing the rest among the other neighbours when a pair is capped (water-filling) settles
-  these runs, but made the pile worse (RMSE 53 -> 71 um, roundness 0.022 -> 0.030 over five
-  settle tolerances); capping the cotangent at that of 1 or 10 degrees did not settle them. Their wall
-  angles in the tables are those of a surface still moving; the default TIN is not affected.
+- **TIN curvature refinement on trenches** (`tin.curvature_tolerance_m = 0.0003`, "tin curved"): was
+  **our code**, fixed. Eight of its nine trench runs per rule in the orientation table ended unsettled
+  after the 20,000 settling passes, with facets near 90 degrees, and their wall angles were those of a
+  surface still moving. Curvature splits of edges lying almost along the last stamp's contours put
+  vertices a hair beside a constraint: chains of slivers that the constraints kept, whose vertices of
+  near-zero area capped every transfer of their neighbours (the cotangent split gives no pair more than f
+  times its excess) to a trickle. Such an edge now stays whole; every run settles, and the default TIN's
+  runs are unchanged bit for bit. (Sharing the capped rest among the other neighbours also settled them,
+  but made the pile worse, RMSE 53 -> 71 um; capping the cotangents did not settle them.)
 - **TIN simplification**: was **our code** (the paper's step 3 never removed a vertex on a flat bed), fixed:
   once the terrain is at rest, near-planar vertices are removed (volume kept, no triangle tilted past the
   stable slope), tens per shipped scene; during strokes the paper's alpha_flat rule alone acts.
 - **TIN trench walls**: the paper's edge rule leaves them 1-4 degrees steeper than critical (a triangle
   whose edges are all stable can stand steeper); the gradient rule brings their mean to within 0.1
   degree of critical at every azimuth (orientation table): **the rule**, now fixed by default. Single
-  cross-sections still stray up to 1.3 degrees on the default mesh (0.35 with curvature refinement, at
-  about 2.5x the TIN's step time): **the method's resolution**.
+  cross-sections still stray up to 1.1 degrees on the default mesh (0.65 with curvature refinement, at
+  about 2.7x the TIN's step time): **the method's resolution**.
 - **TIN memory**: **the method**. A vertex with its triangles costs about 170 bytes against a grid node's
   10, so the TIN wins only where it needs about 17 times fewer elements than a grid of the same accuracy.
 - **Grid speed**: was **our code**, now near the method's limit in double. The dense pass skips stable
