@@ -56,7 +56,7 @@ def sweeps(profile_name, case):
         # Refinement where facet gradients jump (the apex, the toe, a trench's edges), at the
         # default edge length elsewhere: the TIN's own way to spend vertices on accuracy.
         if profile_name != "tiny":
-            tin += [("tin curved 0.3 mm", "tin", ["tin.curvature_tolerance_m=0.0003"])]
+            tin += [("tin curved 0.2 mm", "tin", ["tin.curvature_tolerance_m=0.0002"])]
     return grid + tin
 
 

@@ -165,8 +165,9 @@ notes); the tables below are this run's.
   it over the new vertex's star removes most of them but left the RMSE unchanged (56-58 um), so it was not
   kept. **The method, for the rest**: a piecewise-linear cone on 7 mm edges errs near its apex and toe,
   and the accuracy table's TIN points trade step time for it (4 mm refinement 43 um at 3x the default
-  TIN's step; 2 mm 39 um at 8x; curvature refinement 42 um at 2x), none of them below the grid's curve.
-- **TIN curvature refinement on trenches** (`tin.curvature_tolerance_m = 0.0003`, "tin curved"): was
+  TIN's step; 2 mm 39 um at 8x; curvature refinement at 0.2 mm 38 um at 2.2x in interleaved runs, 3.2x in the table: 1.1x the grid's
+  error at 9x its step time), none of them below the grid's curve.
+- **TIN curvature refinement on trenches** (`tin.curvature_tolerance_m = 0.0003`; "tin curved" is now 0.0002): was
   **our code**, fixed. Eight of its nine trench runs per rule in the orientation table ended unsettled
   after the 20,000 settling passes, with facets near 90 degrees, and their wall angles were those of a
   surface still moving. Curvature splits of edges lying almost along the last stamp's contours put
@@ -181,7 +182,7 @@ notes); the tables below are this run's.
 - **TIN trench walls**: the paper's edge rule leaves them 1-4 degrees steeper than critical (a triangle
   whose edges are all stable can stand steeper); the gradient rule brings their mean to within 0.1
   degree of critical at every azimuth (orientation table): **the rule**, now fixed by default. Single
-  cross-sections still stray up to 1.1 degrees on the default mesh (0.65 with curvature refinement, at
+  cross-sections still stray up to 1.1 degrees on the default mesh (0.54 with curvature refinement at 0.2 mm, 0.65 at 0.3 mm, at
   about 2.7x the TIN's step time): **the method's resolution**.
 - **TIN memory**: **the method**. A vertex with its triangles costs about 170 bytes against a grid node's
   10, so the TIN wins only where it needs about 17 times fewer elements than a grid of the same accuracy.
