@@ -50,10 +50,8 @@ class HeightGrid {
   static constexpr bool kRounds = !std::is_same_v<Real, double>;
   double z(std::size_t k) const { return static_cast<double>(z_[k]); }
   double put(std::size_t k, double target) {
-    const Real stored = static_cast<Real>(target);
-    z_[k] = stored;
-    if constexpr (kRounds) return target - static_cast<double>(stored);
-    return 0.0;
+    z_[k] = static_cast<Real>(target);
+    return rounding_error(target, z_[k]);
   }
   double& carry() { return carry_.m3(); }
   // The heights, row-major (k = iy * nx + ix): the kernel's dense pass reads rows of them at once.

@@ -11,6 +11,18 @@
 
 namespace sb::grid {
 
+// The rounding error (m) of `stored`, the Real that `target` was stored as: what a store of the
+// erosion kernel's storage concept returns from put() (erosion_kernel.hpp); 0 in double.
+template <class Real>
+inline double rounding_error(double target, Real stored) {
+  if constexpr (std::is_same_v<Real, double>) {
+    (void)target, (void)stored;
+    return 0.0;
+  } else {
+    return target - static_cast<double>(stored);
+  }
+}
+
 template <class Real>
 class RoundingCarry {
   static_assert(std::is_same_v<Real, float> || std::is_same_v<Real, double>);

@@ -16,6 +16,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "grid/rounding_carry.hpp"
+
 namespace sb::grid {
 
 template <class Store>
@@ -46,10 +48,8 @@ class RowWindow {
 
   double z(std::size_t k) const { return static_cast<double>(z_[k]); }
   double put(std::size_t k, double target) {
-    const Real stored = static_cast<Real>(target);
-    z_[k] = stored;
-    if constexpr (kRounds) return target - static_cast<double>(stored);
-    return 0.0;
+    z_[k] = static_cast<Real>(target);
+    return rounding_error(target, z_[k]);
   }
   double& carry() { return store_.carry(); }
   Real* data() { return z_.data(); }

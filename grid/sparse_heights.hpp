@@ -106,8 +106,7 @@ class SparseHeights {
     const auto [ix, iy] = split(k);
     const Real stored = static_cast<Real>(target);
     store(ix, iy, stored);
-    if constexpr (kRounds) return target - static_cast<double>(stored);
-    return 0.0;
+    return rounding_error(target, stored);
   }
   double& carry() { return carry_.m3(); }
   // Heights of nodes x0..x1 of row iy, in order, at out[0..x1 - x0] (the kernel's dense pass
