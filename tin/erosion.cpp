@@ -101,6 +101,7 @@ std::size_t TinTerrain::refine_around(VertexHandle v) {
   // has_long_edges' cached answer, read here: erosion asks for every transfer.
   if (v->info().short_edges) return 0;
   std::size_t splits = 0;
+  const double crowded2 = kCrowdedSplit * kCrowdedSplit * refine_m_ * refine_m_;
   for (int guard = 0; guard < 64 && has_long_edges(v); ++guard) {
     // The longest edge that can be split: a constrained edge only where its middle is
     // exactly on it (else the new vertex would sit beside the constraint, in a sliver).
@@ -120,7 +121,6 @@ std::size_t TinTerrain::refine_around(VertexHandle v) {
       // middle: that vertex already resolves the edge, and the new one would be its close
       // neighbour, two small areas that throttle every transfer through them.
       const VertexHandle facing[2] = {f->vertex(i), f->neighbor(i)->vertex(cdt_.mirror_index(f, i))};
-      const double crowded2 = kCrowdedSplit * kCrowdedSplit * refine_m_ * refine_m_;
       bool crowded = false;
       for (VertexHandle o : facing)
         crowded = crowded || (!cdt_.is_infinite(o) && (xy(o) - middle).squaredNorm() < crowded2);

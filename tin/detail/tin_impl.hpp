@@ -276,7 +276,6 @@ class TinTerrain final : public Terrain {
   double gather_neighbours(VertexHandle v);
   std::span<const ErosionNeighbour> nbrs() const { return {nbr_scratch_.data(), ring_n_}; }
   std::span<double> transfers() { return {transfer_scratch_.data(), ring_n_}; }
-  std::size_t ring_n_ = 0;
   // Splits v's edges longer than refine_m_ until none is left that may be split (a constrained
   // edge only where its middle is exactly on it, no edge whose middle a facing vertex crowds);
   // returns the number of splits.
@@ -335,6 +334,7 @@ class TinTerrain final : public Terrain {
   // Scratch reused across calls (counted in stats().bytes).
   std::vector<ErosionNeighbour> nbr_scratch_;
   std::vector<double> transfer_scratch_;
+  std::size_t ring_n_ = 0;  // entries of the three scratch vectors that are the visited vertex's
   std::vector<VertexHandle> vertex_scratch_;
   std::vector<FaceHandle> face_scratch_;
   std::vector<VertexHandle> link_scratch_;
