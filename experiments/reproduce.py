@@ -164,9 +164,9 @@ notes); the tables below are this run's.
   give-back lowers the new vertex by up to 0.3 mm, leaving pits below the bed where no tool went; spreading
   it over the new vertex's star removes most of them but left the RMSE unchanged (56-58 um), so it was not
   kept. **The method, for the rest**: a piecewise-linear cone on 7 mm edges errs near its apex and toe,
-  and the accuracy table's TIN points trade step time for it (4 mm refinement 43 um at 3x the default
-  TIN's step; 2 mm 39 um at 8x; curvature refinement at 0.2 mm 38 um at 2.2x in interleaved runs, 3.2x in the table: 1.1x the grid's
-  error at 9x its step time), none of them below the grid's curve.
+  and the accuracy table's TIN points trade step time for it (4 mm refinement 43 um at 2-3x the default
+  TIN's step; 2 mm 39 um at 5-8x; curvature refinement at 0.2 mm 38 um at 2-3x: 1.1x the grid's error
+  at 9x its step time; the ratios vary that much between runs of the table), none of them below the grid's curve.
 - **TIN curvature refinement on trenches** (`tin.curvature_tolerance_m = 0.0003`; "tin curved" is now 0.0002): was
   **our code**, fixed. Eight of its nine trench runs per rule in the orientation table ended unsettled
   after the 20,000 settling passes, with facets near 90 degrees, and their wall angles were those of a
