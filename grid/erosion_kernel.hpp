@@ -561,6 +561,12 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
   constexpr bool kContiguous = requires { rs.data(); };
   // The row's unstable nodes, one bit each (plus a word: or_bits may write one past the row).
   std::vector<std::uint64_t> flags(words + 1, 0);
+  [[maybe_unused]] const auto w = static_cast<std::ptrdiff_t>(nx);
+  // Whether this row is classed. The classing costs about a third of a group's visit per eight
+  // nodes and saves the groups whose nodes are all stable; where the row before left few such
+  // nodes out of its visits, the next row is visited whole (every node flagged: the same heights
+  // bit for bit, as above). Rows are alike from one to the next on the states this pass is for.
+  bool class_row = true;
   std::size_t prev_lo = 1, prev_hi = 0;  // span of the previous row's transfers (empty)
   std::size_t visited_rows = 0;
   double moved_sum = moved;  // in visiting order, in a register
@@ -590,6 +596,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     std::fill(flags.begin() + static_cast<std::ptrdiff_t>(x0 / 64),
               flags.begin() + static_cast<std::ptrdiff_t>(x1 / 64 + 2), std::uint64_t{0});
     std::size_t skip_lo = 1, skip_hi = 0;  // nodes classed (empty: none)
+    bool classed = false;
     // The row's first node on the store it runs on.
     const std::size_t row_k = kWindowed ? nx : iy * nx;
     if constexpr (kWindowed) window.load(iy, x0 > 0 ? x0 - 1 : 0, std::min(x1 + 1, nx - 1));
@@ -598,14 +605,28 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
         skip_lo = std::max<std::size_t>(1, x0);
         skip_hi = std::min(nx - 2, x1);
         if (skip_lo <= skip_hi) {
-          const RowThresholds<N> c(middle, t.tan_settle() * t.tan_settle());
           const auto* row = std::as_const(rs).data() + row_k;
-          if (lanes == Lanes::Avx512)
-            unstable_bits_avx512<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
-          else if (lanes == Lanes::Avx2)
-            unstable_bits_avx2<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
-          else
-            unstable_bits<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
+          // The row after the next one, fetched while this one is classed: its first reads come
+          // in the next row's classing, a row of visits from now (a large grid streams its rows
+          // from memory; without this the classing waits for them). A hint: no result changes.
+          const std::size_t ahead = y_up ? iy + 2 : iy - 2;  // wraps below 0: past the grid
+          const auto* fetch = kWindowed || ahead >= ny ? nullptr : row + (y_up ? 2 * w : -2 * w);
+          classed = class_row;
+          if (!class_row) {  // every node flagged: the same heights, without the classing's cost
+            set_bits(must, skip_lo, skip_hi);
+            constexpr std::size_t kLine = 64 / sizeof(*row);  // heights per cache line
+            if (fetch != nullptr)
+              for (std::size_t x = skip_lo; x <= skip_hi + kLine - 1; x += kLine)
+                __builtin_prefetch(fetch + std::min(x, skip_hi));
+          } else {
+            const RowThresholds<N> c(middle, t.tan_settle() * t.tan_settle());
+            if (lanes == Lanes::Avx512)
+              unstable_bits_avx512<N, Gradient>(row, nx, skip_lo, skip_hi, c, must, fetch);
+            else if (lanes == Lanes::Avx2)
+              unstable_bits_avx2<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
+            else
+              unstable_bits<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
+          }
         }
       }
     }
@@ -616,6 +637,8 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       if (x1 > skip_hi) set_bits(must, skip_hi + 1, x1);
     }
     std::size_t row_lo = nx, row_hi = 0;  // span of this row's transfers (empty)
+    std::size_t covered = 0;              // nodes visited, the lanes of groups included
+    std::size_t idle = 0;                 // those of them in groups or visits that moved nothing
     const auto transferred = [&](std::size_t ix, const VisitResult& v) __attribute__((always_inline)) {
       transfer_count += static_cast<std::size_t>(v.transfers);
       moved_sum += v.moved;
@@ -626,13 +649,12 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     };
     // The same for the nodes a + 3 l of a group whose lanes l (bits of b) transferred, at once
     // (volumes added in visiting order).
-    const auto group_transferred = [&](std::size_t a, unsigned b, const double* given, std::size_t transfers)
+    const auto group_transferred = [&](std::size_t a, unsigned b, const double* given, int lanes, std::size_t transfers)
         __attribute__((always_inline)) {
-      for (unsigned rest = b; rest != 0;) {
-        const int l = x_up ? std::countr_zero(rest) : 31 - std::countl_zero(rest);
-        rest &= ~(1u << l);
-        moved_sum += given[l];
-      }
+      // Every lane, branch-free (a loop over the bits of b mispredicts its exit, which flushes
+      // the next group's visit the processor had started): a lane that stayed put gave +0.0,
+      // and adding +0.0 to the non-negative sum (never -0.0) leaves it unchanged, bit for bit.
+      for (int i = 0; i < lanes; ++i) moved_sum += given[x_up ? i : lanes - 1 - i];
       transfer_count += transfers;
       const std::uint64_t at = kEveryThird[b];  // bit 3 l: node a + 3 l
       or_bits32(moved_row, a, at);
@@ -644,7 +666,11 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
       if constexpr (kWindowed) window.extend(ix > 0 ? ix - 1 : 0, std::min(ix + 1, nx - 1));  // the span grew
       const VisitResult v =
           erosion_visit<N, Gradient>(rs, t, row_k + ix, ix < 2 || ix + 2 >= nx ? t.of(ix, iy) : middle);
-      if (v.transfers > 0) transferred(ix, v);
+      ++covered;
+      if (v.transfers > 0)
+        transferred(ix, v);
+      else
+        ++idle;
     };
     // Three phases, one per column modulo 3, each in the sweep's direction; on a contiguous
     // store, four nodes of a phase at once where they are interior nodes of the span.
@@ -668,9 +694,12 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
             const std::size_t a = x_up ? ix : ix - 3 * (count - 1);
             double given[8];
             std::size_t transfers = 0;
+            covered += count;
             if (const unsigned b =
                     erosion_visit8<N, Gradient>(rs, t, nx, row_k + a, count, middle, !x_up, given, transfers))
-              group_transferred(a, b, given, transfers);
+              group_transferred(a, b, given, 8, transfers);
+            else
+              idle += count;
             const std::size_t last = x_up ? a + 3 * (count - 1) : a;
             if (x_up ? last >= x1 : last <= x0) break;
             from = x_up ? last + 1 : last - 1;
@@ -679,8 +708,11 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
           if (in_groups && lanes == Lanes::Avx2 && lowest >= four_lo && lowest + 9 <= four_hi) {
             double given[4];
             std::size_t transfers = 0;
+            covered += 4;
             if (const unsigned b = erosion_visit4<N>(rs, t, row_k + lowest, middle, !x_up, given, transfers))
-              group_transferred(lowest, b, given, transfers);
+              group_transferred(lowest, b, given, 4, transfers);
+            else
+              idle += 4;
             const std::size_t last = x_up ? lowest + 9 : lowest;
             if (x_up ? last >= x1 : last <= x0) break;
             from = x_up ? last + 1 : last - 1;
@@ -702,6 +734,11 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     report.updates += x1 - x0 + 1;
     col_lo = std::min(col_lo, x0), col_hi = std::max(col_hi, x1);
     if (row_lo <= row_hi) prev_lo = row_lo, prev_hi = row_hi;
+    // Class the next row where the classing pays (see class_row): this one left more than an
+    // eighth of its span out of its visits (classed), or more than an eighth of its nodes were
+    // visited for nothing (not classed). Tuned on grid_bench's pile, stroke and all-active states.
+    const std::size_t span = x1 - x0 + 1;
+    class_row = (classed ? span - std::min(covered, span) : idle) * 8 > span;
   }
   // Rows in increasing y for the set.
   const std::size_t last = y_up ? first + visited_rows - 1 : first - (visited_rows - 1);

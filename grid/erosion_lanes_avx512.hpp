@@ -89,38 +89,48 @@ template <class Real>
 template <int N, bool Gradient, class Real, class Thresholds>
 [[gnu::target("avx512f,avx512vl,avx512dq,avx512bw")]] void unstable_bits_avx512(const Real* z, std::size_t nx,
                                                                                 std::size_t x0, std::size_t x1,
-                                                                                const Thresholds& c,
-                                                                                std::uint64_t* out) {
+                                                                                const Thresholds& c, std::uint64_t* out,
+                                                                                const Real* fetch = nullptr) {
   const auto w = static_cast<std::ptrdiff_t>(nx);
   bool grouped = true;  // +-x, +-y and the diagonals each share their thresholds
   for (const int s : {1, 3, 5, 6, 7})
     if (s < N) grouped &= c.crit[s] == c.crit[s < 4 ? s - 1 : 4] && c.margin[s] == c.margin[s < 4 ? s - 1 : 4];
-  for (std::size_t x = x0; x <= x1; x += 8) {
-    const auto m = static_cast<__mmask8>((1u << std::min<std::size_t>(8, x1 + 1 - x)) - 1);
+  // In registers (`out` could alias `c` as far as the compiler knows).
+  std::ptrdiff_t off[N];
+  double crit[N], margin[N];
+  for (int s = 0; s < N; ++s) off[s] = c.off[s], crit[s] = c.crit[s], margin[s] = c.margin[s];
+  const double inv_run_x = c.inv_run_x, inv_run_y = c.inv_run_y, tan_settle2 = c.tan_settle2;
+  // The bits of nodes x..x + 7 in `m` (lanes outside it read nothing).
+  const auto classify = [&](std::size_t x, __mmask8 m)
+      __attribute__((always_inline, target("avx512f,avx512vl,avx512dq,avx512bw"))) {
     const Real* p = z + x;
+    if (fetch != nullptr) __builtin_prefetch(fetch + x);  // a hint for a later row
     const Double8 zi = load8(p, m);
     __mmask8 u = 0;
     if (grouped) {
       Double8 zj[N];
 #pragma GCC unroll 8
-      for (int s = 0; s < N; ++s) zj[s] = load8(p + c.off[s], m);
+      for (int s = 0; s < N; ++s) zj[s] = load8(p + off[s], m);
       const Double8 x_low = min8(zj[0], zj[1]), y_low = min8(zj[2], zj[3]);
-      u = greater(zi - x_low - c.crit[0], splat8(c.margin[0])) | greater(zi - y_low - c.crit[2], splat8(c.margin[2]));
+      u = greater(zi - x_low - crit[0], splat8(margin[0])) | greater(zi - y_low - crit[2], splat8(margin[2]));
       if constexpr (N == 8) {
         const Double8 d_low = min8(min8(zj[4], zj[5]), min8(zj[6], zj[7]));
-        u |= greater(zi - d_low - c.crit[4], splat8(c.margin[4]));
+        u |= greater(zi - d_low - crit[4], splat8(margin[4]));
       }
     } else {
 #pragma GCC unroll 8
-      for (int s = 0; s < N; ++s) u |= greater(zi - load8(p + c.off[s], m) - c.crit[s], splat8(c.margin[s]));
+      for (int s = 0; s < N; ++s) u |= greater(zi - load8(p + off[s], m) - crit[s], splat8(margin[s]));
     }
     if constexpr (Gradient) {
-      const Double8 gx = (load8(p + 1, m) - load8(p - 1, m)) * c.inv_run_x;
-      const Double8 gy = (load8(p + w, m) - load8(p - w, m)) * c.inv_run_y;
-      u |= greater(gx * gx + gy * gy, splat8(c.tan_settle2));
+      const Double8 gx = (load8(p + 1, m) - load8(p - 1, m)) * inv_run_x;
+      const Double8 gy = (load8(p + w, m) - load8(p - w, m)) * inv_run_y;
+      u |= greater(gx * gx + gy * gy, splat8(tan_settle2));
     }
     or_bits(out, x, static_cast<std::uint64_t>(u & m));
-  }
+  };
+  std::size_t x = x0;
+  for (; x + 7 <= x1; x += 8) classify(x, 0xFF);  // whole vectors (the mask folds away)
+  if (x <= x1) classify(x, static_cast<__mmask8>((1u << (x1 + 1 - x)) - 1));
 }
 
 // Neighbour positions of the stencil slots (Stencil's order: +x, -x, +y, -y, (+1,+1),
