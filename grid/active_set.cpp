@@ -1,10 +1,51 @@
 #include "grid/active_set.hpp"
 
+#include <immintrin.h>
+
 #include <stdexcept>
 
 #include "grid/sparse_idle_counts.hpp"
 
 namespace sb::grid {
+
+namespace {
+
+// count_up_word's AVX-512 body: the word's 64 counts in two registers of 32, masked by `kept`
+// (nodes past the row's end are never in `kept`: their lanes read and write nothing).
+[[gnu::target("avx512f,avx512bw")]] std::uint64_t count_up_word_avx512(std::uint16_t* counts, std::uint64_t kept,
+                                                                       std::uint16_t idle_passes) {
+  const __m512i one = _mm512_set1_epi16(1), limit = _mm512_set1_epi16(static_cast<short>(idle_passes));
+  std::uint64_t leaving = 0;
+  for (int half = 0; half < 2; ++half) {
+    const auto m = static_cast<__mmask32>(kept >> (32 * half));
+    if (m == 0) continue;
+    std::uint16_t* p = counts + 32 * half;
+    const __m512i c = _mm512_add_epi16(_mm512_maskz_loadu_epi16(m, p), one);
+    const __mmask32 done = _mm512_mask_cmpge_epu16_mask(m, c, limit);
+    _mm512_mask_storeu_epi16(p, m, _mm512_maskz_mov_epi16(static_cast<__mmask32>(m & ~done), c));
+    leaving |= static_cast<std::uint64_t>(done) << (32 * half);
+  }
+  return leaving;
+}
+
+bool has_avx512bw() {
+  static const bool yes = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512bw");
+  return yes;
+}
+
+}  // namespace
+
+std::uint64_t DenseIdleCounts::count_up_word(std::size_t y, std::size_t w, std::uint64_t kept,
+                                             std::uint16_t idle_passes) {
+  std::uint16_t* counts = counts_.data() + y * nx_ + w * 64;
+  if (has_avx512bw()) return count_up_word_avx512(counts, kept, idle_passes);
+  std::uint64_t leaving = 0;
+  for (std::uint64_t b = kept; b != 0; b &= b - 1) {
+    const auto bit = static_cast<unsigned>(std::countr_zero(b));
+    if (++counts[bit] >= idle_passes) counts[bit] = 0, leaving |= std::uint64_t{1} << bit;
+  }
+  return leaving;
+}
 
 void DenseIdleCounts::check(const std::vector<std::uint64_t>& bits, std::size_t words_per_row,
                             std::uint16_t idle_passes, std::vector<std::string>& problems) const {
