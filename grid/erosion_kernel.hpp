@@ -88,25 +88,27 @@
 // neighbour, plus per transfer one division, and a store per receiving neighbour and one
 // for the centre (visits in vector lanes write every slot: no branch per slot); the
 // gradient rule adds a square root and a division per visit. Measured with AVX-512 (Zen 4,
-// tests/bench/grid_bench.cpp, edge rule, 8 neighbours, CPU time, medians of five runs
-// interleaved with the build before the bookkeeping was inlined and cut to the visited
-// columns), M updates/s (an update: one node of a span or one active-set visit): double 90
-// on the pile (before: 83), 135 on the stroke (128), 162 with every node of 2048^2 active
-// (164; 10.8x the plain scalar sweep in the same runs); float 45 (43), 61 (58), 87 (84); the
-// gradient rule (AVX-512 lanes only; AVX2 visits it one node at a time), double: 60 on the
-// pile and 87 on the stroke (57, 83). Measured in the AVX2 lanes (callgrind, which runs no
-// AVX-512), instructions per update, double / float, now (before): grid_bench's pile 199 /
-// 259 (211 / 270), its stroke 141 / 194 (150 / 202); every node of 2048^2 active ~107
-// double. Four visits in AVX2 lanes take ~320 instructions (double); classing a row ~16
-// per node (AVX2, double; ~29 float); rebuilding the active set after a dense pass ~8 per
-// node of the visited columns. Active-set visits add ~100 for the set's bookkeeping. Float
-// costs more than its instructions: the rounding carry chains every transferring visit to
-// the one before (float gains least from the wider lanes). Where the time goes with
-// AVX-512 (perf, sampled): on the pile, ~45 % in the eight-node visits, ~30 % in the pass's
-// bookkeeping (phases, flags, the set's rebuild), ~10 % classing; with every node active,
-// ~53 % visits, ~24 % classing, ~22 % bookkeeping. The sparse grid runs the same paths on a
-// RowWindow (row_window.hpp): three rows copied in and the changed heights written back per
-// row, O(span) each.
+// tests/bench/grid_bench.cpp, edge rule, 8 neighbours, CPU time, medians of nine runs
+// interleaved with the build before the classing was made conditional, the row after next
+// prefetched and the idle counts counted a word at a time; two cores shared with other jobs,
+// so absolute rates run ~10 % below a quiet machine's), M updates/s (an update: one node of a
+// span or one active-set visit): double 84 on the pile (before: 80), 136 on the stroke (119),
+// 168 with every node of 2048^2 active (146; 12.5x the plain scalar sweep in the same runs);
+// float 45 (43), 60 (55), 91 (83); the gradient rule (AVX-512 lanes only; AVX2 visits it one
+// node at a time), double: 57 on the pile and 80 on the stroke (56, 80). Measured in the AVX2
+// lanes (callgrind, which runs no AVX-512), instructions per update, double / float, now
+// (before): grid_bench's pile 181 / 228 (199 / 258), its stroke 126 / 169 (141 / 193). Four
+// visits in AVX2 lanes take ~320 instructions (double); classing a row ~16 per node (AVX2,
+// double; ~29 float); rebuilding the active set after a dense pass ~8 per node of the visited
+// columns. Active-set visits add ~100 for the set's bookkeeping. Float costs more than its
+// instructions: the rounding carry chains every transferring visit to the one before (float
+// gains least from the wider lanes). Where the time goes with AVX-512 (perf, sampled, share of
+// the timed passes): on the pile, ~60 % in the eight-node visits, ~27 % in the pass's
+// bookkeeping (phases, flags, group results), ~9 % rebuilding the set, ~3 % finding the spans,
+// under 1 % classing (before: ~54 / 23 / 8 / 4 / 11); with every node active, ~59 % visits,
+// ~21 % classing, ~16 % bookkeeping, ~4 % the set (before: ~54 / 24 / 14 / 9). The sparse
+// grid runs the same paths on a RowWindow (row_window.hpp): three rows copied in and the
+// changed heights written back per row, O(span) each.
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -308,8 +310,8 @@ template <class Real>
 // same order; AVX2 brings no FMA, so nothing is contracted). The rounding carry (float) is
 // settled lane by lane in visiting order (`reverse`: k + 9 first). Lanes that stay put write
 // their own heights back. Returns the lanes that transferred (bit l: node k + 3 l); then
-// given[l] is the volume lane l gave (m^3) and `transfers` the receiving neighbours of all
-// lanes (both unset when it returns 0), as erosion_visit8 does.
+// given[l] is the volume lane l gave (m^3; +0.0 for lanes that stayed put) and `transfers`
+// the receiving neighbours of all lanes (both unset when it returns 0), as erosion_visit8 does.
 // Heights p[0], p[3], p[6], p[9], widened to double.
 template <class Real>
 [[gnu::target("avx2"), gnu::always_inline]] inline Double4 every3(const Real* p) {
@@ -531,7 +533,13 @@ using WindowOf = typename WindowOfStore<Store>::type;
 // classed with, so skipping it is exactly what its visit would have done: the pass gives the
 // same heights, bit for bit, as visiting every node of the spans (which is what it does on
 // stores with neither data() nor read_row). `lanes` = Sse2 classes in SSE2 registers and visits
-// one node at a time, Avx2 four at a time (the same heights; tests compare).
+// one node at a time, Avx2 four at a time (the same heights; tests compare). The classing is
+// itself a choice that changes no height: a row is classed only where the row before showed it
+// pays (its visits left more than an eighth of its span out, or, not classed, more than an
+// eighth of its nodes were visited for nothing); otherwise every node of the row is flagged.
+// On grid_bench's pile and stroke, where nearly every group of eight nodes of a phase holds one
+// that moves, the classing fell from ~10 % of the time to under 1 %; on its all-active dunes,
+// where whole stretches of a row stay put, most rows are still classed.
 //
 // Cost: O(span nodes) per pass -- the classing vectorised over the row, one visit per
 // unstable node -- plus O(words of the visited rows) to find the spans and update the set.

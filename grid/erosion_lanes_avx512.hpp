@@ -20,8 +20,16 @@
 // read nothing, write nothing and never transfer, so groups at the ends of a row's span need
 // no scalar visits. Cost of a group (8 neighbours): 9 loads and 18 permutes, ~10 vector
 // operations per neighbour, and where a lane transfers 18 permutes and 9 stores; groups with
-// no transfer write nothing. Valgrind runs no AVX-512, so there are no callgrind counts for
-// these paths: erosion_kernel.hpp's header gives their measured throughput.
+// no transfer write nothing: ~190 vector instructions, of which 36 permutes, and a dependency
+// chain of ~80 cycles (loads, permutes, the sum over the slots in their order, the division,
+// the stores) that the processor overlaps with the next group's only in part. Visiting two
+// groups in one block of code (to overlap the chains) was tried and measured ~15 % slower
+// (registers spill); keeping a row chunk in the split layout across the three phases, which
+// would halve the permutes, changes the visiting order at the chunk ends (every path and the
+// goldens with it) and is not done. The classing also fetches the row after next into the
+// cache (one line per vector; a hint, no result changes): on 2048^2 nodes its loads of the next
+// row waited on memory for ~45 % of its time before. Valgrind runs no AVX-512, so there are no
+// callgrind counts for these paths: erosion_kernel.hpp's header gives their measured throughput.
 #include <immintrin.h>
 
 #include <algorithm>
@@ -159,7 +167,8 @@ inline constexpr int kSlotColumn[8] = {2, 0, 1, 1, 2, 0, 2, 0};
 // once: the same as their erosion_visit calls one after the other, bit for bit (their blocks
 // are disjoint). The rounding carry (float) is settled lane by lane in visiting order
 // (`reverse`: the last lane first). Returns the lanes that transferred (bit l: node k + 3 l);
-// then given[l] is the volume lane l gave (m^3) and `transfers` the receiving neighbours of
+// then given[l] is the volume lane l gave (m^3; +0.0 for lanes that stayed put or are masked:
+// the dense pass adds every lane) and `transfers` the receiving neighbours of
 // all lanes (both unset when it returns 0). Gradient: the gradient rule (central differences,
 // the interior class's), as erosion_visit<N, true>; `t`: the ErosionTables.
 template <int N, bool Gradient, class Store, class Class, class Tables>
