@@ -18,6 +18,8 @@ CLIFFS = {
     "angle_5": ("critical angle 5 degrees", ["material.critical_angle_deg=5"], False),
     "angle_1e-6": ("critical angle 1e-6 degrees", ["material.critical_angle_deg=1e-6"], False),
     "box_0.4mm": ("a 0.4 mm box (below one grid cell)", ["tool.shape=box", "tool.size_m=[0.0004, 0.0004]"], True),
+    "blade_sideways": ("a 10 x 60 mm box swept sideways (a blade)", ["tool.shape=box", "tool.size_m=[0.01, 0.06]"],
+                       True),
     "spike_ahead": ("a 0.2 m spike pointing along the motion",
                     ["tool.shape=polygon", "tool.polygon_m=" + SPIKE_AHEAD], True),
     "spike_sideways": ("a 0.2 m spike swept sideways",
