@@ -90,14 +90,13 @@
 // gradient rule adds a square root and a division per visit. Measured with AVX-512 (Zen 4,
 // tests/bench/grid_bench.cpp, edge rule, 8 neighbours, CPU time, medians of nine runs
 // interleaved with the build before the classing was made conditional, the row after next
-// prefetched and the idle counts counted a word at a time; two cores shared with other jobs,
-// so absolute rates run ~10 % below a quiet machine's), M updates/s (an update: one node of a
-// span or one active-set visit): double 84 on the pile (before: 80), 136 on the stroke (119),
-// 168 with every node of 2048^2 active (146; 12.5x the plain scalar sweep in the same runs);
-// float 45 (43), 60 (55), 91 (83); the gradient rule (AVX-512 lanes only; AVX2 visits it one
-// node at a time), double: 57 on the pile and 80 on the stroke (56, 80). Measured in the AVX2
-// lanes (callgrind, which runs no AVX-512), instructions per update, double / float, now
-// (before): grid_bench's pile 181 / 228 (199 / 258), its stroke 126 / 169 (141 / 193). Four
+// prefetched and the idle counts counted a word at a time; two cores shared with other jobs),
+// M updates/s (an update: one node of a span or one active-set visit): double 96 on the pile
+// (before: 82), 141 on the stroke (126), 186 with every node of 2048^2 active (162; 12.4x the
+// plain scalar sweep in the same runs, before 11.6x); float 48 (42), 65 (60), 91 (86); the
+// gradient rule (AVX-512 lanes only; AVX2 visits it one node at a time), double: 65 on the
+// pile and 92 on the stroke (57, 83). Measured in the AVX2 lanes (callgrind, which runs no AVX-512), instructions per
+// update, double / float, now (before): grid_bench's pile 181 / 228 (199 / 258), its stroke 126 / 169 (141 / 193). Four
 // visits in AVX2 lanes take ~320 instructions (double); classing a row ~16 per node (AVX2,
 // double; ~29 float); rebuilding the active set after a dense pass ~8 per node of the visited
 // columns. Active-set visits add ~100 for the set's bookkeeping. Float costs more than its
