@@ -84,10 +84,10 @@
 // the dense pass uses the row-wise half of that (x mod 3 within a row, rows in order), which
 // keeps the along-y avalanche of a row sweep and is exactly a sequential order.
 //
-// Cost per visit: 9 height loads (4-neighbour: 5), ~6 floating-point operations per
-// neighbour, plus per transfer one division, and a store per receiving neighbour and one
-// for the centre (visits in vector lanes write every slot: no branch per slot); the
-// gradient rule adds a square root and a division per visit. Measured with AVX-512 (Zen 4,
+// Cost per visit: 9 height loads (4-neighbour: 5), ~6 floating-point operations per neighbour,
+// plus per transfer one division, and a store per receiving neighbour and one for the centre
+// (visits in vector lanes write every slot: no branch per slot); the gradient rule adds a
+// square root and a division per visit. Measured with AVX-512 (Zen 4,
 // tests/bench/grid_bench.cpp, edge rule, 8 neighbours, CPU time, medians of nine runs
 // interleaved with the build before the classing was made conditional, the row after next
 // prefetched and the idle counts counted a word at a time; two cores shared with other jobs),
@@ -95,19 +95,20 @@
 // (before: 82), 141 on the stroke (126), 186 with every node of 2048^2 active (162; 12.4x the
 // plain scalar sweep in the same runs, before 11.6x); float 48 (42), 65 (60), 91 (86); the
 // gradient rule (AVX-512 lanes only; AVX2 visits it one node at a time), double: 65 on the
-// pile and 92 on the stroke (57, 83). Measured in the AVX2 lanes (callgrind, which runs no AVX-512), instructions per
-// update, double / float, now (before): grid_bench's pile 181 / 228 (199 / 258), its stroke 126 / 169 (141 / 193). Four
-// visits in AVX2 lanes take ~320 instructions (double); classing a row ~16 per node (AVX2,
-// double; ~29 float); rebuilding the active set after a dense pass ~8 per node of the visited
-// columns. Active-set visits add ~100 for the set's bookkeeping. Float costs more than its
-// instructions: the rounding carry chains every transferring visit to the one before (float
-// gains least from the wider lanes). Where the time goes with AVX-512 (perf, sampled, share of
-// the timed passes): on the pile, ~60 % in the eight-node visits, ~27 % in the pass's
-// bookkeeping (phases, flags, group results), ~9 % rebuilding the set, ~3 % finding the spans,
-// under 1 % classing (before: ~54 / 23 / 8 / 4 / 11); with every node active, ~59 % visits,
-// ~21 % classing, ~16 % bookkeeping, ~4 % the set (before: ~54 / 24 / 14 / 9). The sparse
-// grid runs the same paths on a RowWindow (row_window.hpp): three rows copied in and the
-// changed heights written back per row, O(span) each.
+// pile and 92 on the stroke (57, 83). Measured in the AVX2 lanes (callgrind, which runs no
+// AVX-512), instructions per update, double / float, now (before): grid_bench's pile 181 / 228
+// (199 / 258), its stroke 126 / 169 (141 / 193). Four visits in AVX2 lanes take ~320
+// instructions (double); classing a row ~16 per node (AVX2, double; ~29 float); rebuilding the
+// active set after a dense pass ~8 per node of the visited columns. Active-set visits add ~100
+// for the set's bookkeeping. Float costs more than its instructions: the rounding carry chains
+// every transferring visit to the one before (float gains least from the wider lanes). Where
+// the time goes with AVX-512 (perf, sampled, share of the timed passes): on the pile, ~60 % in
+// the eight-node visits, ~27 % in the pass's bookkeeping (phases, flags, group results), ~9 %
+// rebuilding the set, ~3 % finding the spans, under 1 % classing (before: ~54 / 23 / 8 / 4 /
+// 11); with every node active, ~59 % visits, ~21 % classing, ~16 % bookkeeping, ~4 % the set
+// (before: ~54 / 24 / 14 / 9). The sparse grid runs the same paths on a RowWindow
+// (row_window.hpp): three rows copied in and the changed heights written back per row, O(span)
+// each.
 #include <algorithm>
 #include <array>
 #include <bit>

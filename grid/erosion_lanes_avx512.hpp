@@ -13,23 +13,24 @@
 // conversions double <-> float round to nearest as the scalar casts do.
 //
 // Memory. A group of L <= 8 nodes a, a + 3, ..., a + 3 (L - 1) of an interior row reads and
-// writes their 3 x 3 blocks, which tile the columns a - 1 .. a + 3 L - 2 of three rows:
-// nine (masked) vector loads, split into the nine neighbour positions by two permutes
-// each, and after the visit nine permuted (masked) vector stores (nodes that receive nothing
-// get their own heights back, unchanged). Nodes beyond the group (L < 8) are masked: they
-// read nothing, write nothing and never transfer, so groups at the ends of a row's span need
-// no scalar visits. Cost of a group (8 neighbours): 9 loads and 18 permutes, ~10 vector
-// operations per neighbour, and where a lane transfers 18 permutes and 9 stores; groups with
-// no transfer write nothing: ~190 vector instructions, of which 36 permutes, and a dependency
-// chain of ~80 cycles (loads, permutes, the sum over the slots in their order, the division,
+// writes their 3 x 3 blocks, which tile the columns a - 1 .. a + 3 L - 2 of three rows: nine
+// (masked) vector loads, split into the nine neighbour positions by two permutes each, and
+// after the visit nine permuted (masked) vector stores (nodes that receive nothing get their
+// own heights back, unchanged). Nodes beyond the group (L < 8) are masked: they read nothing,
+// write nothing and never transfer, so groups at the ends of a row's span need no scalar
+// visits. Cost of a group (8 neighbours): 9 loads and 18 permutes, ~10 vector operations per
+// neighbour, and where a lane transfers 18 permutes and 9 stores; groups with no transfer
+// write nothing: ~190 vector instructions, of which 36 permutes, and a dependency chain of an
+// estimated ~80 cycles (loads, permutes, the sum over the slots in their order, the division,
 // the stores) that the processor overlaps with the next group's only in part. Visiting two
 // groups in one block of code (to overlap the chains) was tried and measured ~15 % slower
-// (registers spill); keeping a row chunk in the split layout across the three phases, which
-// would halve the permutes, changes the visiting order at the chunk ends (every path and the
-// goldens with it) and is not done. The classing also fetches the row after next into the
-// cache (one line per vector; a hint, no result changes): on 2048^2 nodes its loads of the next
-// row waited on memory for ~45 % of its time before. Valgrind runs no AVX-512, so there are no
-// callgrind counts for these paths: erosion_kernel.hpp's header gives their measured throughput.
+// (likely register spills, not looked into); keeping a row chunk in the split layout across
+// the three phases, which would halve the permutes, changes the visiting order at the chunk
+// ends (every path and the goldens with it) and is not done. The classing also fetches the row
+// after next into the cache (one prefetch per eight nodes; a hint, no result changes): on
+// 2048^2 nodes its loads of the next row waited on memory for ~45 % of its time before.
+// Valgrind runs no AVX-512, so there are no callgrind counts for these paths:
+// erosion_kernel.hpp's header gives their measured throughput.
 #include <immintrin.h>
 
 #include <algorithm>
