@@ -61,9 +61,9 @@ def run(ctx):
                      tin["relax_updates"], grid["relax_updates"], tin["vertices"],
                      "yes" if tin["settled"] else "NO", "yes" if grid["settled"] else "NO",
                      f"{tin['volume_drift_rel']:.1e}", f"{grid['volume_drift_rel']:.1e}", "yes" if ok else "no"])
-    md = ctx.table("cliffs", ["cliff", "what", "tin s", "grid s", "tin / grid", "tin settling updates",
+    md = ctx.table("cliffs", ["cliff", "what", "tin s", "grid s", "time tin / grid", "tin settling updates",
                               "grid settling updates", "tin vertices", "tin settled", "grid settled", "tin drift",
-                              "grid drift", "within the bar"], rows)
+                              "grid drift", "within the bar (time ratio too)"], rows)
     return f"""## Cliffs: the edges of the envelope
 
 {md}
