@@ -190,8 +190,10 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
   const auto gradient_at = [&](VertexHandle v) {
     return rule.needs_gradient() ? fan_gradient(v->point().z(), nbrs()) : SurfaceGradient{};
   };
-  for (int pass = 0; pass < budget.max_passes && !erosion_list_.empty() && report.updates < budget.max_updates;
-       ++pass) {
+  // Settling budgets: the cascade moves the sand far first (settle_region.cpp), the passes finish.
+  settle_with_cascade(rule, budget, report);
+  for (int pass = report.passes;
+       pass < budget.max_passes && !erosion_list_.empty() && report.updates < budget.max_updates; ++pass) {
     ++report.passes;
     work.resize(erosion_list_.size());
     for (std::size_t k = 0; k < work.size(); ++k) work[k] = erosion_list_[k].vertex;

@@ -1,0 +1,293 @@
+// The TIN's settling cascade on plain arrays (settle_cascade.hpp has the method, its
+// conservation and energy arguments, and when it runs).
+#include "tin/settle_cascade.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+#include <utility>
+
+namespace sb::tin {
+
+namespace {
+
+// One level: per node (a vertex on level 0, a cluster above) its area, position, height,
+// restricted height and neighbours (CSR), and per node of the finer level its parent here.
+struct Level {
+  std::vector<double> area, x, y, z, z0;
+  std::vector<std::uint32_t> adj_begin, adj;
+  std::vector<std::int64_t> cell_x, cell_y;  // the node's cell on this level (clusters only)
+  std::vector<std::uint32_t> parent_of_finer;
+  std::vector<std::uint8_t> active;
+  std::size_t size() const { return z.size(); }
+};
+
+// Neighbour lists, both directions, from undirected pairs (duplicates and self-pairs dropped).
+void build_adjacency(Level& level, std::vector<std::pair<std::uint32_t, std::uint32_t>>& pairs) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> both;
+  both.reserve(2 * pairs.size());
+  for (const auto& [a, b] : pairs) {
+    if (a == b) continue;
+    both.emplace_back(a, b);
+    both.emplace_back(b, a);
+  }
+  std::sort(both.begin(), both.end());
+  both.erase(std::unique(both.begin(), both.end()), both.end());
+  level.adj_begin.assign(level.size() + 1, 0);
+  level.adj.resize(both.size());
+  for (std::size_t k = 0; k < both.size(); ++k) {
+    ++level.adj_begin[both[k].first + 1];
+    level.adj[k] = both[k].second;
+  }
+  for (std::size_t i = 0; i < level.size(); ++i) level.adj_begin[i + 1] += level.adj_begin[i];
+}
+
+// The clusters of `finer` by cells of side `cell` (finer's cells halved when finer is a
+// cluster level); restricted areas, positions, heights, activity; adjacency from finer's.
+Level coarsen(const Level& finer, bool finer_is_vertices, double x0, double y0, double cell) {
+  Level c;
+  const std::size_t n = finer.size();
+  std::unordered_map<std::uint64_t, std::uint32_t> index;
+  index.reserve(n);
+  std::vector<std::uint32_t> parent(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::int64_t cx = 0, cy = 0;
+    if (finer_is_vertices) {
+      cx = static_cast<std::int64_t>(std::floor((finer.x[i] - x0) / cell));
+      cy = static_cast<std::int64_t>(std::floor((finer.y[i] - y0) / cell));
+    } else {
+      cx = finer.cell_x[i] >> 1;
+      cy = finer.cell_y[i] >> 1;
+    }
+    const std::uint64_t key = (static_cast<std::uint64_t>(cx) << 32) ^ static_cast<std::uint64_t>(cy & 0xffffffff);
+    const auto [it, fresh] = index.emplace(key, static_cast<std::uint32_t>(c.cell_x.size()));
+    if (fresh) {
+      c.cell_x.push_back(cx);
+      c.cell_y.push_back(cy);
+    }
+    parent[i] = it->second;
+  }
+  const std::size_t m = c.cell_x.size();
+  c.area.assign(m, 0.0);
+  c.x.assign(m, 0.0);
+  c.y.assign(m, 0.0);
+  c.z.assign(m, 0.0);
+  c.active.assign(m, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint32_t p = parent[i];
+    const double a = finer.area[i];
+    c.area[p] += a;
+    c.x[p] += a * finer.x[i];
+    c.y[p] += a * finer.y[i];
+    c.z[p] += a * finer.z[i];
+    c.active[p] |= finer.active[i];
+  }
+  for (std::size_t p = 0; p < m; ++p) {
+    if (!(c.area[p] > 0.0)) continue;  // (zero-area members only: the cluster never moves sand)
+    c.x[p] /= c.area[p];
+    c.y[p] /= c.area[p];
+    c.z[p] /= c.area[p];
+  }
+  c.z0 = c.z;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::uint32_t k = finer.adj_begin[i]; k < finer.adj_begin[i + 1]; ++k)
+      if (finer.adj[k] > i && parent[i] != parent[finer.adj[k]]) pairs.emplace_back(parent[i], parent[finer.adj[k]]);
+  build_adjacency(c, pairs);
+  c.parent_of_finer = std::move(parent);
+  return c;
+}
+
+double energy(const Level& l) {
+  double e = 0.0;
+  for (std::size_t i = 0; i < l.size(); ++i) e += 0.5 * l.area[i] * l.z[i] * l.z[i];
+  return e;
+}
+
+// Gauss-Seidel passes of the rule over the level's active nodes (as TinTerrain::erode visits
+// L_e: a node that gives re-activates itself and its neighbours; one idle too long leaves).
+void relax(Level& l, const ErosionRule& rule, const CascadeOptions& o, CascadeLevelReport& lr, CascadeReport& r) {
+  const std::size_t n = l.size();
+  std::vector<std::uint32_t> list, work;
+  std::vector<std::uint8_t> in_list(n, 0);
+  std::vector<std::uint16_t> idle(n, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (l.active[i] && l.area[i] > 0.0) {
+      list.push_back(static_cast<std::uint32_t>(i));
+      in_list[i] = 1;
+    }
+  const auto touch = [&](std::uint32_t i) {
+    idle[i] = 0;
+    if (in_list[i]) return;
+    in_list[i] = 1;
+    list.push_back(i);
+  };
+  std::vector<ErosionNeighbour> nbrs;
+  std::vector<double> out;
+  for (int pass = 0; pass < o.max_passes_per_level && !list.empty(); ++pass) {
+    ++lr.passes;
+    work = list;
+    for (const std::uint32_t i : work) {
+      if (!in_list[i]) continue;
+      ++lr.updates;
+      const std::uint32_t b = l.adj_begin[i], e = l.adj_begin[i + 1];
+      nbrs.clear();
+      for (std::uint32_t k = b; k < e; ++k) {
+        const std::uint32_t j = l.adj[k];
+        const double dx = l.x[j] - l.x[i], dy = l.y[j] - l.y[i];
+        nbrs.push_back({l.z[j], std::sqrt(dx * dx + dy * dy), l.area[j], dx, dy});
+      }
+      out.resize(nbrs.size());
+      const double total = erosion_transfers(l.z[i], l.area[i], {}, nbrs, rule, out, NeighbourLayout::Stencil);
+      if (total > 0.0) {
+        l.z[i] -= total / l.area[i];
+        touch(i);
+        for (std::uint32_t k = b; k < e; ++k) {
+          const std::uint32_t j = l.adj[k];
+          touch(j);
+          if (out[k - b] <= 0.0) continue;
+          l.z[j] += out[k - b] / l.area[j];
+          ++r.transfers;
+        }
+        r.moved_m3 += total;
+      } else if (++idle[i] >= o.idle_passes) {
+        in_list[i] = 0;
+      }
+    }
+    std::erase_if(list, [&](std::uint32_t i) { return !in_list[i]; });
+  }
+  r.updates += lr.updates;
+}
+
+// The fine level: the rule as the TIN's passes apply it (Fan layout, the fan gradient under the
+// gradient rule), on the vertices whose whole ring is in the region.
+void relax_fine(std::span<double> z, std::span<const double> area, std::span<const double> x, std::span<const double> y,
+                std::span<const std::uint32_t> ring_begin, std::span<const std::uint32_t> ring,
+                std::span<const std::uint8_t> active, const ErosionRule& rule, const CascadeOptions& o,
+                CascadeLevelReport& lr, CascadeReport& r) {
+  const std::size_t n = z.size();
+  std::vector<std::uint32_t> list, work;
+  std::vector<std::uint8_t> in_list(n, 0);
+  std::vector<std::uint16_t> idle(n, 0);
+  const auto visited = [&](std::uint32_t i) { return ring_begin[i + 1] > ring_begin[i]; };
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (active[i] && visited(i)) {
+      list.push_back(i);
+      in_list[i] = 1;
+    }
+  const auto touch = [&](std::uint32_t i) {
+    idle[i] = 0;
+    if (in_list[i] || !visited(i)) return;
+    in_list[i] = 1;
+    list.push_back(i);
+  };
+  // The rings' offsets, distances and areas do not change (the mesh does not): laid out once,
+  // a visit only reads the heights in (a sixth of a visit's time went to the square roots).
+  std::vector<ErosionNeighbour> nbrs(ring.size());
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (std::uint32_t k = ring_begin[i]; k < ring_begin[i + 1]; ++k) {
+      const std::uint32_t j = ring[k];
+      const double dx = x[j] - x[i], dy = y[j] - y[i];
+      nbrs[k] = {0.0, std::sqrt(dx * dx + dy * dy), area[j], dx, dy};
+    }
+  std::vector<double> out;
+  for (int pass = 0; pass < o.max_fine_passes && !list.empty(); ++pass) {
+    ++lr.passes;
+    work = list;
+    for (const std::uint32_t i : work) {
+      if (!in_list[i]) continue;
+      ++lr.updates;
+      const std::uint32_t b = ring_begin[i], e = ring_begin[i + 1];
+      for (std::uint32_t k = b; k < e; ++k) nbrs[k].z = z[ring[k]];
+      const std::span<const ErosionNeighbour> fan(nbrs.data() + b, e - b);
+      out.resize(fan.size());
+      const SurfaceGradient g = rule.needs_gradient() ? fan_gradient(z[i], fan) : SurfaceGradient{};
+      const double total = erosion_transfers(z[i], area[i], g, fan, rule, out, NeighbourLayout::Fan);
+      if (total > 0.0 && area[i] > 0.0) {
+        z[i] -= total / area[i];
+        touch(i);
+        for (std::uint32_t k = b; k < e; ++k) touch(ring[k]);
+        for (std::uint32_t k = b; k < e; ++k) {
+          const std::uint32_t j = ring[k];
+          if (out[k - b] <= 0.0 || area[j] <= 0.0) continue;
+          z[j] += out[k - b] / area[j];
+          if (rule.needs_gradient() && visited(j))  // its neighbours' fan gradients read it
+            for (std::uint32_t m = ring_begin[j]; m < ring_begin[j + 1]; ++m) touch(ring[m]);
+          ++r.transfers;
+        }
+        r.moved_m3 += total;
+      } else if (++idle[i] >= o.idle_passes) {
+        in_list[i] = 0;
+      }
+    }
+    std::erase_if(list, [&](std::uint32_t i) { return !in_list[i]; });
+  }
+  r.updates += lr.updates;
+}
+
+}  // namespace
+
+CascadeReport settle_cascade(CascadeRegion& region, const ErosionRule& given, const CascadeOptions& options) {
+  CascadeReport report;
+  const std::size_t n = region.size();
+  if (n == 0 || !(options.cell_m > 0.0)) return report;
+  ErosionRule rule = given;
+  rule.kind = ErosionRuleKind::Edge;  // clusters have no facet gradient
+
+  // Level 0: the vertices.
+  std::vector<Level> levels(1);
+  Level& fine = levels[0];  // (only until levels grows)
+  fine.area = region.area;
+  fine.x = region.x;
+  fine.y = region.y;
+  fine.z = region.z;
+  fine.active = region.active;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+  pairs.reserve(region.edges.size() / 2);
+  for (std::size_t k = 0; k + 1 < region.edges.size(); k += 2) pairs.emplace_back(region.edges[k], region.edges[k + 1]);
+  build_adjacency(fine, pairs);
+  const double x0 = *std::min_element(region.x.begin(), region.x.end());
+  const double y0 = *std::min_element(region.y.begin(), region.y.end());
+
+  // Restriction, every level from the same fine state (the energy argument needs it).
+  double cell = options.cell_m;
+  for (int k = 1; k <= options.max_levels; ++k, cell *= 2.0) {
+    Level c = coarsen(levels.back(), k == 1, x0, y0, cell);
+    const std::size_t finer = levels.back().size();
+    if (c.size() < kCascadeMinClusters || 5 * c.size() > 4 * finer) break;
+    levels.push_back(std::move(c));
+  }
+  if (levels.size() < 2 && !options.fine_level) return report;
+
+  // Coarsest to level 1: relax, then add the level's change to its children.
+  for (std::size_t k = levels.size() - 1; k >= 1; --k) {
+    Level& l = levels[k];
+    Level& finer = levels[k - 1];
+    CascadeLevelReport lr;
+    lr.clusters = l.size();
+    if (options.measure_energy) lr.energy_before = energy(l);
+    relax(l, rule, options, lr, report);
+    if (options.measure_energy) lr.energy_after = energy(l);
+    for (std::size_t i = 0; i < l.size(); ++i) lr.changed += l.z[i] != l.z0[i];
+    for (std::size_t c = 0; c < finer.size(); ++c) {
+      const std::uint32_t p = l.parent_of_finer[c];
+      const double dz = l.z[p] - l.z0[p];
+      if (dz == 0.0) continue;
+      finer.z[c] += dz;
+      finer.active[c] = 1;
+    }
+    report.levels.push_back(lr);
+  }
+  std::reverse(report.levels.begin(), report.levels.end());
+  Level& vertices = levels[0];
+  if (options.fine_level && region.ring_begin.size() == n + 1) {
+    if (options.measure_energy) report.fine.energy_before = energy(vertices);
+    relax_fine(vertices.z, vertices.area, vertices.x, vertices.y, region.ring_begin, region.ring, vertices.active,
+               given, options, report.fine, report);
+    if (options.measure_energy) report.fine.energy_after = energy(vertices);
+  }
+  region.z = vertices.z;
+  return report;
+}
+
+}  // namespace sb::tin
