@@ -250,6 +250,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
   // it, with L_e's, once everything has settled).
   if (erosion_list_.empty()) {
     std::vector<ErosionEntry>().swap(erosion_list_);
+    std::vector<VertexHandle>().swap(work);  // (a copy of L_e as it was at its largest)
     std::vector<VertexHandle>().swap(ring_pool_);
     ring_pool_live_ = 0;
   } else if (ring_pool_.capacity() > 256 && 4 * ring_pool_live_ < ring_pool_.capacity()) {

@@ -42,9 +42,10 @@ void build_adjacency(Level& level, std::vector<std::pair<std::uint32_t, std::uin
   for (std::size_t i = 0; i < level.size(); ++i) level.adj_begin[i + 1] += level.adj_begin[i];
 }
 
-// The clusters of `finer` by cells of side `cell` (finer's cells halved when finer is a
-// cluster level); restricted areas, positions, heights, activity; adjacency from finer's.
-Level coarsen(const Level& finer, bool finer_is_vertices, double x0, double y0, double cell) {
+// The clusters of `finer` by cells of side `cell` (vertices), or by finer's cells merged 2^shift
+// x 2^shift (a cluster level); restricted areas, positions, heights, activity; adjacency from
+// finer's.
+Level coarsen(const Level& finer, bool finer_is_vertices, double x0, double y0, double cell, int shift) {
   Level c;
   const std::size_t n = finer.size();
   std::unordered_map<std::uint64_t, std::uint32_t> index;
@@ -56,8 +57,8 @@ Level coarsen(const Level& finer, bool finer_is_vertices, double x0, double y0, 
       cx = static_cast<std::int64_t>(std::floor((finer.x[i] - x0) / cell));
       cy = static_cast<std::int64_t>(std::floor((finer.y[i] - y0) / cell));
     } else {
-      cx = finer.cell_x[i] >> 1;
-      cy = finer.cell_y[i] >> 1;
+      cx = finer.cell_x[i] >> shift;
+      cy = finer.cell_y[i] >> shift;
     }
     const std::uint64_t key = (static_cast<std::uint64_t>(cx) << 32) ^ static_cast<std::uint64_t>(cy & 0xffffffff);
     const auto [it, fresh] = index.emplace(key, static_cast<std::uint32_t>(c.cell_x.size()));
@@ -250,12 +251,20 @@ CascadeReport settle_cascade(CascadeRegion& region, const ErosionRule& given, co
   const double y0 = *std::min_element(region.y.begin(), region.y.end());
 
   // Restriction, every level from the same fine state (the energy argument needs it).
+  // A cell size that merges too little (vertices as far apart as the cells) is skipped: the
+  // next level tries cells twice as large.
   double cell = options.cell_m;
+  int shift = 1;  // from the last level kept
   for (int k = 1; k <= options.max_levels; ++k, cell *= 2.0) {
-    Level c = coarsen(levels.back(), k == 1, x0, y0, cell);
-    const std::size_t finer = levels.back().size();
-    if (c.size() < kCascadeMinClusters || 5 * c.size() > 4 * finer) break;
+    const bool from_vertices = levels.size() == 1;
+    Level c = coarsen(levels.back(), from_vertices, x0, y0, cell, shift);
+    if (c.size() < kCascadeMinClusters) break;
+    if (5 * c.size() > 4 * levels.back().size()) {
+      ++shift;
+      continue;
+    }
     levels.push_back(std::move(c));
+    shift = 1;
   }
   if (levels.size() < 2 && !options.fine_level) return report;
 

@@ -18,7 +18,14 @@ void TinTerrain::settle_with_cascade(const ErosionRule& rule, const ErosionBudge
   const Vec2 side = box.hi - box.lo;
   box = intersection(box.expanded(std::max(0.25 * std::max(side.x(), side.y()), 2.0 * refine_m_)), box_);
   std::vector<VertexHandle> vertices;
+  // (collect_vertices queues the box's faces in face_scratch_: its growth is given back, the
+  // stamps never need that much.)
+  const std::size_t face_capacity = face_scratch_.capacity();
   collect_vertices(box, vertices);
+  if (face_scratch_.capacity() > face_capacity) {
+    std::vector<FaceHandle>().swap(face_scratch_);
+    face_scratch_.reserve(face_capacity);
+  }
   std::erase_if(vertices, [&](VertexHandle v) { return has_long_edges(v); });
   if (vertices.size() > static_cast<std::size_t>(budget.max_passes) * active) return;
 
