@@ -441,6 +441,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   s.tin.contour_gap_m = f.number("tin.contour_gap_m", 0.0, closed(0.0, extent));
   s.tin.refine_m = f.number("tin.refine_m", 0.0, closed(0.0, extent));
   s.tin.curvature_tolerance_m = f.number("tin.curvature_tolerance_m", 0.0, closed(0.0, 1e6));
+  s.tin.curvature_while_stamping = f.choice("tin.curvature_when", "always", {"always", "settling"}) == "always";
   s.tin.refine_min_m = f.number("tin.refine_min_m", 0.0, closed(0.0, extent));
   s.tin.planar_tolerance_m = f.number("tin.planar_tolerance_m", 0.0, closed(0.0, 1e6));
   s.tin.coarsen = f.boolean("tin.coarsen", true);

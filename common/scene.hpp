@@ -73,6 +73,10 @@ struct TinSpec {
   // interpolation along that crease errs by about length * dg / 4: erosion also splits edges
   // whose error exceeds curvature_tolerance_m, down to refine_min_m (0: refine_m / 2; at least refine_m / 4). 0: off.
   double curvature_tolerance_m = 0.0;
+  // Whether that refinement also runs while a tool works (true, "always") or only while the
+  // sand settles (false, "settling": ErosionBudget::settling), keeping the strokes' steps as
+  // cheap as without it and refining the creases of the surface that comes to rest.
+  bool curvature_while_stamping = true;
   double refine_min_m = 0.0;
   // coarsen: once the terrain is at rest, simplification also removes vertices within
   // planar_tolerance_m of the plane fitted to their neighbours (volume-preserving; 0:

@@ -61,6 +61,8 @@ std::string scene_key_meaning(const std::string& key) {
        "at least half the tool radius, at most 5% of the domain"},
       {"tin.curvature_tolerance_m",
        "erosion also splits edges sand flows across where length x facet-gradient jump / 4 exceeds this; 0: off"},
+      {"tin.curvature_when",
+       "when curvature refinement runs: always, or only while the sand settles (no tool that step)"},
       {"tin.refine_min_m",
        "the shortest edge that split may make (at least a quarter of tin.refine_m); 0: half of tin.refine_m"},
       {"tin.planar_tolerance_m", "height tolerance of the coarsening; 0: tin.tolerance_m / 4"},

@@ -35,6 +35,10 @@ struct StampReport {
 struct ErosionBudget {
   int max_passes = 4;                                                 // passes over the active set in this call
   std::size_t max_updates = std::numeric_limits<std::size_t>::max();  // element visits
+  // The sand is left to come to rest (no tool this step: the runner's settling, an idle
+  // interactive step). A back-end may spend work here that only pays at rest; the TIN refines
+  // creases then when tin.curvature_when = "settling".
+  bool settling = false;
 };
 
 struct ErosionReport {

@@ -57,6 +57,10 @@ def sweeps(profile_name, case):
         # default edge length elsewhere: the TIN's own way to spend vertices on accuracy.
         if profile_name != "tiny":
             tin += [("tin curved 0.2 mm", "tin", ["tin.curvature_tolerance_m=0.0002"])]
+            # The same refinement only while the sand settles: the strokes' steps cost what
+            # the default TIN's do, and the surface at rest gets the creases refined.
+            tin += [("tin curved 0.2 mm at rest", "tin",
+                     ["tin.curvature_tolerance_m=0.0002", "tin.curvature_when=settling"])]
     return grid + tin
 
 

@@ -190,6 +190,8 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
   const auto gradient_at = [&](VertexHandle v) {
     return rule.needs_gradient() ? fan_gradient(v->point().z(), nbrs()) : SurfaceGradient{};
   };
+  // Curvature refinement (tin.curvature_tolerance_m), unless it waits for the sand to settle.
+  const bool creases = fine_m_ < refine_m_ && (budget.settling || spec_.curvature_while_stamping);
   // Settling budgets: the cascade moves the sand far first (settle_region.cpp), the passes finish.
   settle_with_cascade(rule, budget, report);
   for (int pass = report.passes;
@@ -210,7 +212,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
         std::size_t splits = refine_around(v);
         for (std::size_t k = 0; k < ring_n_; ++k)
           if (transfer_scratch_[k] > 0.0) splits += refine_around(vertex_scratch_[k]);
-        if (splits == 0 && fine_m_ < refine_m_ && refine_crease(v)) splits = 1;
+        if (splits == 0 && creases && refine_crease(v)) splits = 1;
         if (splits == 0) break;
         area = gather_neighbours(v);
         total =

@@ -127,7 +127,7 @@ class TerrainTyped : public ::testing::Test {
   // Erodes and simplifies until settled; false if it did not settle.
   static bool relax(Terrain& t, const Scene& s) {
     for (int passes = 0; passes < 200000; passes += 64) {
-      t.erode(rule(s), ErosionBudget{64});
+      t.erode(rule(s), ErosionBudget{.max_passes = 64, .settling = true});
       t.simplify(SimplifyParams{s.tin.alpha_flat_deg});
       if (t.stats().active == 0) return true;
     }

@@ -122,7 +122,8 @@ TEST(TinErosion, APileOnTwoTrianglesRefinesAndRelaxesToACone) {
 // rule) with check() and the volume (exact: tin.conserve_volume) after every step, settled.
 struct PileOutcome {
   std::size_t vertices = 0;
-  double spread = 0.0;  // std / mean of the half-height radius's heights over 32 directions
+  std::size_t poured_vertices = 0;  // after the pours, before settling
+  double spread = 0.0;              // std / mean of the half-height radius's heights over 32 directions
   double top = 0.0;
 };
 void pour_pile(const std::vector<std::string>& keys, PileOutcome& out) {
@@ -138,6 +139,7 @@ void pour_pile(const std::vector<std::string>& keys, PileOutcome& out) {
     SB_ASSERT_TIN_OK(*t);
     EXPECT_NEAR(t->volume(), v0 + added, 1e-13 * v0);
   }
+  out.poured_vertices = t->stats().vertices;
   EXPECT_TRUE(relax(*t, s));
   SB_EXPECT_TIN_OK(*t);
   EXPECT_NEAR(t->volume(), v0 + added, 1e-13 * v0);
@@ -179,6 +181,22 @@ TEST(TinErosion, CurvatureRefinementSplitsCreasesWhereSandFlows) {
       std::cbrt(3.0 * 2e-5 / (std::numbers::pi * std::tan(std::numbers::pi / 6.0))) * std::tan(std::numbers::pi / 6.0);
   EXPECT_NEAR(on.top, ideal_top, 0.05 * ideal_top);
   EXPECT_NEAR(off.top, ideal_top, 0.05 * ideal_top);
+}
+
+// tin.curvature_when = "settling": no crease is split while the tool pours (the steps run as
+// without curvature refinement, vertex for vertex), and the creases of the settling pile are.
+TEST(TinErosion, CurvatureRefinementWhileSettlingLeavesThePoursAlone) {
+  PileOutcome off, always, settling;
+  pour_pile({}, off);
+  pour_pile({"tin.curvature_tolerance_m=0.0003"}, always);
+  pour_pile({"tin.curvature_tolerance_m=0.0003", "tin.curvature_when=settling"}, settling);
+  EXPECT_GT(always.poured_vertices, off.poured_vertices);
+  EXPECT_EQ(settling.poured_vertices, off.poured_vertices);
+  EXPECT_GT(settling.vertices, off.vertices);
+  EXPECT_LT(settling.spread, 0.03);
+  const double ideal_top =
+      std::cbrt(3.0 * 2e-5 / (std::numbers::pi * std::tan(std::numbers::pi / 6.0))) * std::tan(std::numbers::pi / 6.0);
+  EXPECT_NEAR(settling.top, ideal_top, 0.05 * ideal_top);
 }
 
 // A trench at 22.5 degrees with curvature refinement (trench_azimuth.toml's stroke): splits

@@ -110,7 +110,7 @@ inline void step(Terrain& t, const Scene& s, const ToolStamp& st) {
 inline bool relax(Terrain& t, const Scene& s, int max_passes = 200000) {
   const ErosionRule rule = rule_of(s);
   for (int done = 0; done < max_passes; done += 64) {
-    t.erode(rule, ErosionBudget{64});
+    t.erode(rule, ErosionBudget{.max_passes = 64, .settling = true});
     t.simplify(SimplifyParams{s.tin.alpha_flat_deg});
     if (t.stats().active == 0) return true;
   }
