@@ -29,8 +29,9 @@
 // Then the fine level (CascadeOptions::fine_level): the vertices whose whole ring lies in the
 // region are relaxed with the fine rule exactly as TinTerrain::erode applies it (the rule's
 // kind, the fan gradient, cotangent conductances over the counter-clockwise ring, the same
-// re-activation), over plain arrays whose offsets, distances and areas are laid out once: the
-// diffusive tail at the mesh's scale at about 80 ns a visit instead of about 140. Only without
+// re-activation), over plain arrays whose offsets, distances, areas, conductances and fan
+// gradient coefficients are laid out once: the diffusive tail at the mesh's scale at about 700
+// instructions a visit instead of about 1500. Only without
 // curvature refinement (tin.curvature_tolerance_m = 0, the default), which splits creases
 // between vertices with short edges that the fine passes must make; and region vertices have
 // no edge longer than the refinement length, so the fine passes would split nothing there.
@@ -78,9 +79,9 @@
 // Cost: O(region x degree) to gather the region (a hash lookup per edge end), O(region) per
 // level to restrict and inject, plus the levels' visits (at most max_passes_per_level passes
 // each, max_fine_passes on the fine level; counted as updates, the call as one pass); memory
-// about 250 B per region vertex, freed on return. Measured (flat_stroke.toml, tool.depth_m =
-// 0.2, medians of 5 interleaved runs): settling 361k updates, 38.6 ms before; 159k updates
-// (7.5k on clusters, 142k on the fine level, a few thousand TIN visits), 12.9 ms after.
+// about 600 B per region vertex (the fine level's laid-out rings), freed on return. Measured (flat_stroke.toml,
+// tool.depth_m = 0.2, medians of 5 interleaved runs): settling 361k updates, 38.6 ms before; 159k updates (7.5k on
+// clusters, 142k on the fine level, a few thousand TIN visits), 12.9 ms after.
 #include <cstddef>
 #include <cstdint>
 #include <span>
