@@ -20,6 +20,7 @@ import engines
 import sbrun
 import exp_accuracy
 import exp_alpha_flat
+import exp_cliffs
 import exp_drift
 import exp_fig5_6
 import exp_fig7
@@ -45,6 +46,7 @@ EXPERIMENTS = {
     "pile_relax": exp_pile_relax,
     "settling": exp_settling,
     "stability": exp_stability,
+    "cliffs": exp_cliffs,
     "haptics": exp_haptics,
 }
 

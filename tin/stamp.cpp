@@ -247,6 +247,16 @@ bool TinTerrain::plan_stamp(const ToolStamp& s, StampWork& w) {
   return true;
 }
 
+int TinTerrain::long_edge_pieces(const Vec2& a, const Vec2& b) const {
+  // A contour edge much longer than the mesh's edges (a box's or a polygon's side; a disk's
+  // sides are about refine_m_ long) is cut into equal pieces of at most refine_m_, on O and on I
+  // alike: else the band between them, a gap wide, is triangulated by slivers as long as the
+  // edge, whose splits land beside the contours (a 0.2 m spike swept sideways on
+  // flat_stroke.toml settled after 29 M visits of a mesh full of sub-millimetre slivers).
+  const double length = (b - a).norm();
+  return length > 2.0 * refine_m_ ? static_cast<int>(std::ceil(length / refine_m_)) : 1;
+}
+
 void TinTerrain::contour_points(StampWork& w) const {
   // O's heights from the terrain, subdivided (recursively, at midpoints) where the terrain
   // along an edge is not linear within tin.tolerance_m.
@@ -274,7 +284,8 @@ void TinTerrain::contour_points(StampWork& w) const {
     const double za = height(a);
     w.o_pts.push_back({a, za});
     if (on_same_box_side(a, b, box_)) continue;
-    const int pieces = step > 0.0 ? std::max(1, static_cast<int>(std::ceil((b - a).norm() / step))) : 1;
+    const int pieces =
+        std::max(step > 0.0 ? static_cast<int>(std::ceil((b - a).norm() / step)) : 1, long_edge_pieces(a, b));
     Vec2 pa = a;
     double zpa = za;
     for (int k = 1; k <= pieces; ++k) {
@@ -290,7 +301,17 @@ void TinTerrain::contour_points(StampWork& w) const {
   // I (at the terrain's height until 1d lowers it); interior points for a curved bottom.
   const ToolStamp& s = w.tool;
   const std::vector<Vec2>& footprint = s.footprint;
-  for (const Vec2& p : w.inner_clip) w.i_pts.push_back({p, height(p)});
+  const std::size_t ni = w.inner_clip.size();
+  for (std::size_t i = 0; i < ni; ++i) {
+    const Vec2 a = w.inner_clip[i], b = w.inner_clip[(i + 1) % ni];
+    w.i_pts.push_back({a, height(a)});
+    if (on_same_box_side(a, b, box_)) continue;
+    const int pieces = long_edge_pieces(a, b);
+    for (int k = 1; k < pieces; ++k) {
+      const Vec2 p = a + (b - a) * (static_cast<double>(k) / pieces);
+      w.i_pts.push_back({p, height(p)});
+    }
+  }
   if (s.profile == BottomProfile::SphereCap && !w.inner_clip.empty()) {
     for (double t : {0.75, 0.5, 0.25}) {
       for (const Vec2& f : footprint) {

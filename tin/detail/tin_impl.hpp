@@ -233,8 +233,9 @@ class TinTerrain final : public Terrain {
   // The footprint made ready (checked, cut to what the mesh resolves), the contours O and I
   // clipped to the domain; false when O misses the domain.
   bool plan_stamp(const ToolStamp& s, StampWork& w);
-  void contour_points(StampWork& w) const;   // 1a: O's heights, I, interior and rim points
-  void find_constraints_near(StampWork& w);  // old constraints within reach of O (w.dropped)
+  void contour_points(StampWork& w) const;                   // 1a: O's heights, I, interior and rim points
+  int long_edge_pieces(const Vec2& a, const Vec2& b) const;  // pieces of a contour edge (1: whole)
+  void find_constraints_near(StampWork& w);                  // old constraints within reach of O (w.dropped)
   // The stamp's vertices inserted; old ones between I and O (and just outside O) removed.
   void insert_stamp_vertices(StampWork& w, StampReport& report);
   void constrain_contours(const StampWork& w);               // 1b, 1c
