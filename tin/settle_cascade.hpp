@@ -83,7 +83,7 @@
 // (flat_stroke.toml, tool.depth_m = 0.2, medians of 9 interleaved runs against the code before
 // the cascade): settling 361k updates in 56 ms before, 136k updates (clusters, fine level and
 // the TIN's closing passes) in 16 ms after; stroke + settling 16.9x the grid's before, 8.5x
-// after. The other shipped scenes: 18-42 % fewer settling updates (pile.toml: no cascade).
+// after. The other shipped scenes: 17-41 % fewer settling updates (pile.toml: no cascade).
 #include <cstddef>
 #include <cstdint>
 #include <span>
