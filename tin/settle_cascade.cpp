@@ -105,58 +105,74 @@ double energy(const Level& l) {
   return e;
 }
 
+// A level's active set, visited in passes as TinTerrain::erode visits L_e: a member that gives
+// re-activates what its change may unsettle (touch), one that does not leaves after
+// idle_passes idle visits; only eligible nodes ever join.
+class Worklist {
+ public:
+  explicit Worklist(std::vector<std::uint8_t> eligible)
+      : eligible_(std::move(eligible)), in_(eligible_.size(), 0), idle_(eligible_.size(), 0) {}
+  void touch(std::uint32_t i) {
+    idle_[i] = 0;
+    if (in_[i] || !eligible_[i]) return;
+    in_[i] = 1;
+    list_.push_back(i);
+  }
+  bool empty() const { return list_.empty(); }
+  // One pass over the members as they were at its start; visit(i) returns whether i gave.
+  template <class Visit>
+  void pass(int idle_passes, CascadeLevelReport& lr, Visit&& visit) {
+    ++lr.passes;
+    work_ = list_;
+    for (const std::uint32_t i : work_) {
+      if (!in_[i]) continue;
+      ++lr.updates;
+      if (!visit(i) && ++idle_[i] >= idle_passes) in_[i] = 0;
+    }
+    std::erase_if(list_, [&](std::uint32_t i) { return !in_[i]; });
+  }
+
+ private:
+  std::vector<std::uint8_t> eligible_, in_;
+  std::vector<std::uint16_t> idle_;
+  std::vector<std::uint32_t> list_, work_;
+};
+
 // Gauss-Seidel passes of the rule over the level's active nodes (as TinTerrain::erode visits
 // L_e: a node that gives re-activates itself and its neighbours; one idle too long leaves).
 void relax(Level& l, const ErosionRule& rule, const CascadeOptions& o, CascadeLevelReport& lr, CascadeReport& r) {
   const std::size_t n = l.size();
-  std::vector<std::uint32_t> list, work;
-  std::vector<std::uint8_t> in_list(n, 0);
-  std::vector<std::uint16_t> idle(n, 0);
-  for (std::size_t i = 0; i < n; ++i)
-    if (l.active[i] && l.area[i] > 0.0) {
-      list.push_back(static_cast<std::uint32_t>(i));
-      in_list[i] = 1;
-    }
-  const auto touch = [&](std::uint32_t i) {
-    idle[i] = 0;
-    if (in_list[i]) return;
-    in_list[i] = 1;
-    list.push_back(i);
-  };
+  std::vector<std::uint8_t> eligible(n);
+  for (std::size_t i = 0; i < n; ++i) eligible[i] = l.area[i] > 0.0;
+  Worklist list(std::move(eligible));
+  for (std::uint32_t i = 0; i < n; ++i)
+    if (l.active[i]) list.touch(i);
   std::vector<ErosionNeighbour> nbrs;
   std::vector<double> out;
-  for (int pass = 0; pass < o.max_passes_per_level && !list.empty(); ++pass) {
-    ++lr.passes;
-    work = list;
-    for (const std::uint32_t i : work) {
-      if (!in_list[i]) continue;
-      ++lr.updates;
-      const std::uint32_t b = l.adj_begin[i], e = l.adj_begin[i + 1];
-      nbrs.clear();
-      for (std::uint32_t k = b; k < e; ++k) {
-        const std::uint32_t j = l.adj[k];
-        const double dx = l.x[j] - l.x[i], dy = l.y[j] - l.y[i];
-        nbrs.push_back({l.z[j], std::sqrt(dx * dx + dy * dy), l.area[j], dx, dy});
-      }
-      out.resize(nbrs.size());
-      const double total = erosion_transfers(l.z[i], l.area[i], {}, nbrs, rule, out, NeighbourLayout::Stencil);
-      if (total > 0.0) {
-        l.z[i] -= total / l.area[i];
-        touch(i);
-        for (std::uint32_t k = b; k < e; ++k) {
-          const std::uint32_t j = l.adj[k];
-          touch(j);
-          if (out[k - b] <= 0.0) continue;
-          l.z[j] += out[k - b] / l.area[j];
-          ++r.transfers;
-        }
-        r.moved_m3 += total;
-      } else if (++idle[i] >= o.idle_passes) {
-        in_list[i] = 0;
-      }
+  const auto visit = [&](std::uint32_t i) {
+    const std::uint32_t b = l.adj_begin[i], e = l.adj_begin[i + 1];
+    nbrs.clear();
+    for (std::uint32_t k = b; k < e; ++k) {
+      const std::uint32_t j = l.adj[k];
+      const double dx = l.x[j] - l.x[i], dy = l.y[j] - l.y[i];
+      nbrs.push_back({l.z[j], std::sqrt(dx * dx + dy * dy), l.area[j], dx, dy});
     }
-    std::erase_if(list, [&](std::uint32_t i) { return !in_list[i]; });
-  }
+    out.resize(nbrs.size());
+    const double total = erosion_transfers(l.z[i], l.area[i], {}, nbrs, rule, out, NeighbourLayout::Stencil);
+    if (!(total > 0.0)) return false;
+    l.z[i] -= total / l.area[i];
+    list.touch(i);
+    for (std::uint32_t k = b; k < e; ++k) {
+      const std::uint32_t j = l.adj[k];
+      list.touch(j);
+      if (out[k - b] <= 0.0) continue;
+      l.z[j] += out[k - b] / l.area[j];
+      ++r.transfers;
+    }
+    r.moved_m3 += total;
+    return true;
+  };
+  for (int pass = 0; pass < o.max_passes_per_level && !list.empty(); ++pass) list.pass(o.idle_passes, lr, visit);
   r.updates += lr.updates;
 }
 
@@ -167,21 +183,12 @@ void relax_fine(std::span<double> z, std::span<const double> area, std::span<con
                 std::span<const std::uint8_t> active, const ErosionRule& rule, const CascadeOptions& o,
                 CascadeLevelReport& lr, CascadeReport& r) {
   const std::size_t n = z.size();
-  std::vector<std::uint32_t> list, work;
-  std::vector<std::uint8_t> in_list(n, 0);
-  std::vector<std::uint16_t> idle(n, 0);
   const auto visited = [&](std::uint32_t i) { return ring_begin[i + 1] > ring_begin[i]; };
+  std::vector<std::uint8_t> eligible(n);
+  for (std::uint32_t i = 0; i < n; ++i) eligible[i] = visited(i);
+  Worklist list(std::move(eligible));
   for (std::uint32_t i = 0; i < n; ++i)
-    if (active[i] && visited(i)) {
-      list.push_back(i);
-      in_list[i] = 1;
-    }
-  const auto touch = [&](std::uint32_t i) {
-    idle[i] = 0;
-    if (in_list[i] || !visited(i)) return;
-    in_list[i] = 1;
-    list.push_back(i);
-  };
+    if (active[i]) list.touch(i);
   // The rings' offsets, distances, areas and conductances do not change (the mesh does not):
   // laid out once, a visit only reads the heights in. So are the fan gradient's coefficients:
   // fan_gradient is linear in the height differences, g = sum_k c_k (z_k - z_i), with c_k from
@@ -219,43 +226,37 @@ void relax_fine(std::span<double> z, std::span<const double> area, std::span<con
     }
   }
   std::vector<double> out;
-  for (int pass = 0; pass < o.max_fine_passes && !list.empty(); ++pass) {
-    ++lr.passes;
-    work = list;
-    for (const std::uint32_t i : work) {
-      if (!in_list[i]) continue;
-      ++lr.updates;
-      const std::uint32_t b = ring_begin[i], e = ring_begin[i + 1];
-      SurfaceGradient g;
-      for (std::uint32_t k = b; k < e; ++k) {
-        const double zk = z[ring[k]];
-        nbrs[k].z = zk;
-        g.x += gcx[k] * (zk - z[i]);
-        g.y += gcy[k] * (zk - z[i]);
-      }
-      const std::span<const ErosionNeighbour> fan(nbrs.data() + b, e - b);
-      out.resize(fan.size());
-      const double total =
-          erosion_transfers(z[i], area[i], g, fan, rule, out, NeighbourLayout::Fan, conductance.data() + b);
-      if (total > 0.0 && area[i] > 0.0) {
-        z[i] -= total / area[i];
-        touch(i);
-        for (std::uint32_t k = b; k < e; ++k) touch(ring[k]);
-        for (std::uint32_t k = b; k < e; ++k) {
-          const std::uint32_t j = ring[k];
-          if (out[k - b] <= 0.0 || area[j] <= 0.0) continue;
-          z[j] += out[k - b] / area[j];
-          if (rule.needs_gradient() && visited(j))  // its neighbours' fan gradients read it
-            for (std::uint32_t m = ring_begin[j]; m < ring_begin[j + 1]; ++m) touch(ring[m]);
-          ++r.transfers;
-        }
-        r.moved_m3 += total;
-      } else if (++idle[i] >= o.idle_passes) {
-        in_list[i] = 0;
-      }
+  const bool gradient = rule.needs_gradient();
+  const auto visit = [&](std::uint32_t i) {
+    const std::uint32_t b = ring_begin[i], e = ring_begin[i + 1];
+    SurfaceGradient g;
+    for (std::uint32_t k = b; k < e; ++k) {
+      const double zk = z[ring[k]];
+      nbrs[k].z = zk;
+      if (!gradient) continue;
+      g.x += gcx[k] * (zk - z[i]);
+      g.y += gcy[k] * (zk - z[i]);
     }
-    std::erase_if(list, [&](std::uint32_t i) { return !in_list[i]; });
-  }
+    const std::span<const ErosionNeighbour> fan(nbrs.data() + b, e - b);
+    out.resize(fan.size());
+    const double total =
+        erosion_transfers(z[i], area[i], g, fan, rule, out, NeighbourLayout::Fan, conductance.data() + b);
+    if (!(total > 0.0 && area[i] > 0.0)) return false;
+    z[i] -= total / area[i];
+    list.touch(i);
+    for (std::uint32_t k = b; k < e; ++k) list.touch(ring[k]);
+    for (std::uint32_t k = b; k < e; ++k) {
+      const std::uint32_t j = ring[k];
+      if (out[k - b] <= 0.0 || area[j] <= 0.0) continue;
+      z[j] += out[k - b] / area[j];
+      if (gradient)  // its neighbours' fan gradients read it
+        for (std::uint32_t m = ring_begin[j]; m < ring_begin[j + 1]; ++m) list.touch(ring[m]);
+      ++r.transfers;
+    }
+    r.moved_m3 += total;
+    return true;
+  };
+  for (int pass = 0; pass < o.max_fine_passes && !list.empty(); ++pass) list.pass(o.idle_passes, lr, visit);
   r.updates += lr.updates;
 }
 

@@ -146,25 +146,12 @@ TEST(TinSettleCascade, SmallRegionsAndStrokeBudgetsUseNoCascade) {
   EXPECT_EQ(r.z, z0);
 }
 
-// flat_stroke.toml's setup with a tool deeper than the bed: about 1000 vertices active when
-// the stroke ends, so the runner's settling budgets run the cascade.
-const char* kDeepStroke = R"(
-[domain]
-size_m = [0.70710678, 0.70710678]
-[terrain]
-kind = "flat"
-height_m = 0.1
-[material]
-critical_angle_deg = 30.0
-[tool]
-shape = "disk"
-radius_m = 0.02
-sides = 32
-depth_m = 0.2
-[stroke]
-path_m = [[0.31820, 0.31820], [0.38891, 0.38891]]
-spacing_m = 0.005
-)";
+// flat_stroke.toml with a tool deeper than the bed: about 1000 vertices active when the
+// stroke ends, so the runner's settling budgets run the cascade.
+Scene deep_stroke(const std::string& rule) {
+  return load_scene(SB_SOURCE_DIR "/experiments/scenes/flat_stroke.toml",
+                    {"tool.depth_m=0.2", "erosion.rule=\"" + rule + "\""});
+}
 
 struct Settled {
   std::unique_ptr<Terrain> terrain;
@@ -191,7 +178,7 @@ Settled stroke_and_settle(const Scene& s, int passes) {
 TEST(TinSettleCascade, TinSettlesToReposeWithFewerUpdates) {
   for (const char* rule : {"edge", "gradient"}) {
     SCOPED_TRACE(rule);
-    const Scene s = scene(kDeepStroke, {std::string("erosion.rule=\"") + rule + "\""});
+    const Scene s = deep_stroke(rule);
     const Settled cascade = stroke_and_settle(s, 64);
     const Settled fine = stroke_and_settle(s, kCascadeMinPasses - 1);
     for (const Settled* r : {&cascade, &fine}) {
