@@ -161,10 +161,13 @@ inline double fan_conductance(std::span<const ErosionNeighbour> ring, std::size_
 
 // Computes the volume (m^3, >= 0) the centre sends to each neighbour into `out` (same size
 // as `nbrs`) and returns the total. Zero when every slope is stable. `gradient` is read by
-// the gradient rule only; `layout` decides the conductances (above). O(neighbours).
+// the gradient rule only; `layout` decides the conductances (above). `conductances` (Fan only,
+// optional): fan_conductance(nbrs, k) for every k, computed beforehand by a caller that visits
+// the same ring many times. O(neighbours).
 inline double erosion_transfers(double z_i, double area_i, SurfaceGradient gradient,
                                 std::span<const ErosionNeighbour> nbrs, const ErosionRule& rule, std::span<double> out,
-                                NeighbourLayout layout = NeighbourLayout::Stencil) {
+                                NeighbourLayout layout = NeighbourLayout::Stencil,
+                                const double* conductances = nullptr) {
   // Downhill unit vector, where the gradient rule applies.
   double ux = 0.0, uy = 0.0, steepness = 0.0;
   bool along_gradient = false;
@@ -201,7 +204,7 @@ inline double erosion_transfers(double z_i, double area_i, SurfaceGradient gradi
     if (layout == NeighbourLayout::Stencil) {
       out[k] = excess_v;
     } else {
-      const double c = fan_conductance(nbrs, k);
+      const double c = conductances ? conductances[k] : fan_conductance(nbrs, k);
       out[k] = c * excess_h;  // the share
       sum_share += out[k];
       min_ratio = std::min(min_ratio, pair_weight / c);  // e_j / share_j

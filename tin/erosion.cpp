@@ -192,8 +192,10 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
   };
   // Curvature refinement (tin.curvature_tolerance_m), unless it waits for the sand to settle.
   const bool creases = fine_m_ < refine_m_ && (budget.settling || spec_.curvature_while_stamping);
-  for (int pass = 0; pass < budget.max_passes && !erosion_list_.empty() && report.updates < budget.max_updates;
-       ++pass) {
+  // Settling budgets: the cascade moves the sand far first (settle_region.cpp), the passes finish.
+  settle_with_cascade(rule, budget, report);
+  for (int pass = report.passes;
+       pass < budget.max_passes && !erosion_list_.empty() && report.updates < budget.max_updates; ++pass) {
     ++report.passes;
     work.resize(erosion_list_.size());
     for (std::size_t k = 0; k < work.size(); ++k) work[k] = erosion_list_[k].vertex;
@@ -250,6 +252,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
   // it, with L_e's, once everything has settled).
   if (erosion_list_.empty()) {
     std::vector<ErosionEntry>().swap(erosion_list_);
+    std::vector<VertexHandle>().swap(work);  // (a copy of L_e as it was at its largest)
     std::vector<VertexHandle>().swap(ring_pool_);
     ring_pool_live_ = 0;
   } else if (ring_pool_.capacity() > 256 && 4 * ring_pool_live_ < ring_pool_.capacity()) {

@@ -31,7 +31,11 @@
 //                     split is O(1). A visit reads its vertex's ring from L_e's cache (the
 //                     neighbours in CGAL's circulator order, walked again only after the star
 //                     changed; check() compares it with the star), heights and cached areas
-//                     fresh; no allocation per visit (scratch and pool grow amortized)
+//                     fresh; no allocation per visit (scratch and pool grow amortized).
+//                     Settling budgets (the runner's, >= 32 passes) with >= 512 active
+//                     vertices first run a coarse-to-fine cascade over the region around L_e
+//                     (settle_cascade.hpp: clusters of refinement-length cells, then the fine
+//                     rule over plain arrays), O(region x degree) plus its visits
 //   simplify          detect O(|L_r| * degree); removal O(degree) per vertex; with
 //                     tin.coarsen, once per rest after activity: detect O(n * degree)
 //   one step          stamp + 4 erosion passes + simplify: 0.6 to 0.7 ms CPU at every n from

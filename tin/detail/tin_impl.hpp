@@ -281,6 +281,10 @@ class TinTerrain final : public Terrain {
   // edge only where its middle is exactly on it, no edge whose middle a facing vertex crowds);
   // returns the number of splits.
   std::size_t refine_around(VertexHandle v);
+  // settle_region.cpp: the coarse-to-fine cascade (tin/settle_cascade.hpp) over the region
+  // around L_e, when the budget is a settling one (cascade_pays); the vertices it changes join
+  // L_e with their neighbours, and L_r. Counted in `report` as one pass.
+  void settle_with_cascade(const ErosionRule& rule, const ErosionBudget& budget, ErosionReport& report);
   // Curvature refinement: splits v's longest edge longer than fine_m_ that sand crosses (a
   // transfer in transfer_scratch_) and across which the gradients of its two facets jump by
   // more than 4 curvature_tolerance_m_ / length (linear interpolation along such a crease
