@@ -31,10 +31,10 @@
 // kind, the fan gradient, cotangent conductances over the counter-clockwise ring, the same
 // re-activation), over plain arrays whose offsets, distances, areas, conductances and fan
 // gradient coefficients are laid out once: the diffusive tail at the mesh's scale at about 700
-// instructions a visit instead of about 1500. Only without
-// curvature refinement (tin.curvature_tolerance_m = 0, the default), which splits creases
-// between vertices with short edges that the fine passes must make; and region vertices have
-// no edge longer than the refinement length, so the fine passes would split nothing there.
+// instructions a visit instead of about 1500. Region vertices have no edge longer than the
+// refinement length, so the fine passes would split nothing there. The TIN runs no cascade with
+// curvature refinement (tin.curvature_tolerance_m > 0; settle_region.cpp): its crease splits
+// need the fine passes, and the clusters cost it accuracy.
 //
 // Piecewise constant, as the grid: the detail under a cluster (a cut wall, a rim) is kept and
 // shifted by the cluster's change; the fine passes settle it locally. A plane's area-weighted
