@@ -136,8 +136,9 @@ notes); the tables below are this run's.
   its neighbours, the walls of passed stamps left vertex pairs under a millimetre apart (tiny areas that
   throttle every transfer through them; now thinned once the stamp has passed), and a split measured its
   volume change over a box of its surroundings (now over the faces the insertion replaced). The TIN's
-  trench step fell from 1.24 ms two rounds ago to 0.79 ms now; the grid's, brought to its own limit, from
-  0.24 to 0.10 ms, so the ratio is 7.7x (interleaved medians, 7 rounds). Where it goes: the TIN needs
+  trench step fell from 1.24 ms three rounds ago to 0.79 ms; the grid's, brought to its own limit, from
+  0.24 to 0.10 ms, so the ratio is 7.8-8.1x (interleaved medians, 7 rounds, at the start and the end of
+  the last round, whose grid kernel got faster and whose TIN work went to settling and to the cliffs). Where it goes: the TIN needs
   fewer erosion updates than the grid during the stroke (0.43x on the trench, 0.62x on the pile: the
   method's advantage, fewer elements), but one update costs 6-14x the grid's (about 100 ns on a settled
   mesh, 130-240 ns during a stroke with its splits, against 14-28 ns for the grid's eight-lane visits), and
@@ -209,10 +210,11 @@ notes); the tables below are this run's.
 - **Grid speed**: was **our code**, now near the method's limit in double. The dense pass skips stable
   nodes by bit scans over vector-classed rows and visits up to eight independent nodes at once (columns
   modulo 3; AVX-512 lanes with masked ends, the gradient rule included; AVX2 and SSE2 where the CPU lacks
-  them), bit for bit the scalar visits: on `grid_bench`'s states 90 M updates/s on the pile and 136 M on
-  the stroke (36-51 three rounds ago), 169 M with every node of 2048^2 active, 11x a plain scalar sweep of
-  the same rule (interleaved medians, 5 rounds). What stops it short of the 100 M on the pile and 250 M
-  all active it aims at: the in-place (Gauss-Seidel) order that the default transfer fraction needs to
+  them), bit for bit the scalar visits; rows are classed only where that pays, the active set is updated a
+  word at a time: on `grid_bench`'s states 96 M updates/s on the pile and 141 M on the stroke (36-51 four
+  rounds ago, 82 and 126 at this round's start), 186 M with every node of 2048^2 active (162), 12x a plain
+  scalar sweep of the same rule (interleaved medians, 9 rounds). What stops it short of the 100 M on the
+  pile and 250 M all active it aims at: the in-place (Gauss-Seidel) order that the default transfer fraction needs to
   stay monotone (a Jacobi or four-colour sweep overshoots at f = 0.5), the permutes that gather a 3 x 3
   block per lane (36 per group of eight; keeping a row chunk in column layout across the three phases
   would change the visiting order), and, in float, the rounding carry that chains every transfer to the
