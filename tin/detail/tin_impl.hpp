@@ -269,8 +269,8 @@ class TinTerrain final : public Terrain {
   // erosion.cpp: splits edge (a, b) at its middle (volume change measured, and compensated
   // under tin.conserve_volume); returns the vertex there.
   VertexHandle split_edge(VertexHandle a, VertexHandle b, bool* inserted);
-  // Whether m, the middle of edge (a, b), lies a hair beside a constrained edge of the two faces
-  // beside (a, b) (split_edge then refuses the split). O(1).
+  // Whether m, the middle of edge (a, b), lies a hair beside a constrained edge or a border edge of
+  // the two faces beside (a, b) (split_edge then refuses the split). O(1).
   bool beside_a_constraint(VertexHandle a, VertexHandle b, const Vec2& m) const;
   // v's neighbours (the first ring_n_ of vertex_scratch_) with heights, distances and areas
   // (of nbr_scratch_: nbrs()); returns v's area.
