@@ -162,7 +162,10 @@ notes); the tables below are this run's.
   to slivers as long as a side, and erosion's splits beside the constraints filled the trench with
   sub-millimetre ones, so a 0.2 m spike settled only after 29 M updates (10 s) and a 10 x 60 mm blade not
   at all (facets at 35 degrees); sides are now cut into pieces of at most `tin.refine_m` on both contours
-  (about 20k updates each). The ratios that stay above 10x are tools the grid's 5 mm cells barely see (a
+  (about 20k updates each). Swept across the domain's border, such tools also left edges running almost
+  along it, which erosion split into chains of slivers against the border (unsettled after 40000 passes,
+  facets at 54 degrees): the border now holds like a constraint when an edge is split (1408 passes).
+  The ratios that stay above 10x are tools the grid's 5 mm cells barely see (a
   0.4 mm box, the blade's 10 mm and the spikes' thin ends): there the grid moves almost no sand while the
   TIN cuts the footprint, which is **the method** (the TIN models what the grid cannot), not a cost to cut.
 - **TIN pile with the default (gradient) rule**: was **our code**, fixed; what is left is the method at
