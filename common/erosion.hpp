@@ -140,6 +140,34 @@ inline SurfaceGradient fan_gradient(double z_i, std::span<const ErosionNeighbour
   return {sx / area2, sy / area2};
 }
 
+// fan_gradient as a linear map of the height differences, for a caller that evaluates the same
+// ring's gradient many times: fan_gradient(z_i, ring) = sum_k (cx[k], cy[k]) (ring[k].z - z_i),
+// the coefficients from the ring's offsets alone (facet_moment's terms over twice the fan's
+// area; zero when no pair forms a facet). `cx`, `cy`: the ring's size. O(ring size).
+inline void fan_gradient_coefficients(std::span<const ErosionNeighbour> ring, std::span<double> cx,
+                                      std::span<double> cy) {
+  const std::size_t n = ring.size();
+  std::fill(cx.begin(), cx.end(), 0.0);
+  std::fill(cy.begin(), cy.end(), 0.0);
+  double area2 = 0.0;
+  for (std::size_t a = 0; a < n && n >= 2; ++a) {
+    const std::size_t b = a + 1 < n ? a + 1 : 0;
+    const ErosionNeighbour &p = ring[a], &q = ring[b];
+    double gx = 0.0, gy = 0.0, cross = 0.0;
+    if (!facet_moment(0.0, p, q, gx, gy, cross)) continue;
+    area2 += cross;
+    // facet_moment: gx = h_p q.dy - h_q p.dy, gy = h_q p.dx - h_p q.dx.
+    cx[a] += q.dy;
+    cy[a] -= q.dx;
+    cx[b] -= p.dy;
+    cy[b] += p.dx;
+  }
+  for (std::size_t a = 0; a < n; ++a) {
+    cx[a] = area2 > 0.0 ? cx[a] / area2 : 0.0;
+    cy[a] = area2 > 0.0 ? cy[a] / area2 : 0.0;
+  }
+}
+
 // The cotangent weight of the edge from the centre to ring[k] in a counter-clockwise ring
 // (NeighbourLayout::Fan): (cot a + cot b) / 2 over the facets beside it that exist, floored at
 // kMinConductance. O(1).

@@ -34,11 +34,7 @@ REPEATS = 5
 def footprint_scene(folder):
     """flat_stroke.toml without the disk's keys (radius, sides), kept with the runs."""
     lines = [ln for ln in BASE.read_text().splitlines() if not ln.startswith(("radius_m", "sides"))]
-    path = folder / "flat_stroke_footprint.toml"
-    text = "\n".join(lines) + "\n"
-    if not path.exists() or path.read_text() != text:
-        path.write_text(text)
-    return path
+    return sbrun.write_scene(folder / "flat_stroke_footprint.toml", "\n".join(lines) + "\n")
 
 
 def stroke_and_settle_s(summary):

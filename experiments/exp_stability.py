@@ -55,10 +55,7 @@ def scene_with(text_marker, folder):
         text = text.replace("size_m = [0.70710678, 0.70710678]", "size_m = [-0.7, 0.7]")
     else:
         text = text.replace("radius_m = 0.02", text_marker)
-    path = Path(folder) / f"bad-{re.sub(r'[^a-z0-9]+', '_', text_marker.lower())}.toml"
-    if not path.exists() or path.read_text() != text:
-        path.write_text(text)
-    return path
+    return sbrun.write_scene(Path(folder) / f"bad-{re.sub(r'[^a-z0-9]+', '_', text_marker.lower())}.toml", text)
 
 
 def classify(name, backend, proc, summary, run_file):

@@ -153,6 +153,15 @@ class Context:
         return md
 
 
+def write_scene(path, text):
+    """A scene variant kept with the runs (a cluster's nodes must read it), rewritten only when its
+    text changed (runs are keyed on their inputs); returns the path."""
+    path = Path(path)
+    if not path.exists() or path.read_text() != text:
+        path.write_text(text)
+    return path
+
+
 def loglog_slope(xs, ys):
     """Least-squares exponent b of y = a x^b over the positive points (nan if fewer than 2)."""
     pts = [(math.log(x), math.log(y)) for x, y in zip(xs, ys) if x > 0 and y > 0]

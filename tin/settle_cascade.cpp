@@ -190,13 +190,12 @@ void relax_fine(std::span<double> z, std::span<const double> area, std::span<con
   for (std::uint32_t i = 0; i < n; ++i)
     if (active[i]) list.touch(i);
   // The rings' offsets, distances, areas and conductances do not change (the mesh does not):
-  // laid out once, a visit only reads the heights in. So are the fan gradient's coefficients:
-  // fan_gradient is linear in the height differences, g = sum_k c_k (z_k - z_i), with c_k from
-  // the two facets beside edge k (facet_moment's terms over twice the fan's area). Measured
+  // laid out once, a visit only reads the heights in. So are the fan gradient's coefficients
+  // (fan_gradient_coefficients: it is linear in the height differences). Measured
   // (callgrind, flat_stroke.toml with tool.depth_m = 0.2, same visits): 117 M instructions in
   // the fine level with the per-visit geometry, 88 M with it laid out.
   std::vector<ErosionNeighbour> nbrs(ring.size());
-  std::vector<double> conductance(ring.size()), gcx(ring.size(), 0.0), gcy(ring.size(), 0.0);
+  std::vector<double> conductance(ring.size()), gcx(ring.size()), gcy(ring.size());
   for (std::uint32_t i = 0; i < n; ++i) {
     const std::uint32_t b = ring_begin[i], e = ring_begin[i + 1];
     for (std::uint32_t k = b; k < e; ++k) {
@@ -205,25 +204,8 @@ void relax_fine(std::span<double> z, std::span<const double> area, std::span<con
       nbrs[k] = {0.0, std::sqrt(dx * dx + dy * dy), area[j], dx, dy};
     }
     const std::span<const ErosionNeighbour> fan(nbrs.data() + b, e - b);
-    const std::size_t m = fan.size();
-    double area2 = 0.0;
-    for (std::size_t a = 0; a < m && m >= 2; ++a) {
-      const ErosionNeighbour &p = fan[a], &q = fan[a + 1 < m ? a + 1 : 0];
-      const double cross = p.dx * q.dy - p.dy * q.dx;
-      if (!(cross > 1e-9 * p.distance * q.distance)) continue;  // (facet_moment's test)
-      area2 += cross;
-      // gx += h_p q.dy - h_q p.dy, gy += h_q p.dx - h_p q.dx (facet_moment).
-      const std::size_t pa = b + a, qa = b + (a + 1 < m ? a + 1 : 0);
-      gcx[pa] += q.dy;
-      gcy[pa] -= q.dx;
-      gcx[qa] -= p.dy;
-      gcy[qa] += p.dx;
-    }
-    for (std::size_t a = 0; a < m; ++a) {
-      conductance[b + a] = fan_conductance(fan, a);
-      gcx[b + a] = area2 > 0.0 ? gcx[b + a] / area2 : 0.0;
-      gcy[b + a] = area2 > 0.0 ? gcy[b + a] / area2 : 0.0;
-    }
+    fan_gradient_coefficients(fan, std::span(gcx).subspan(b, e - b), std::span(gcy).subspan(b, e - b));
+    for (std::size_t a = 0; a < fan.size(); ++a) conductance[b + a] = fan_conductance(fan, a);
   }
   std::vector<double> out;
   const bool gradient = rule.needs_gradient();

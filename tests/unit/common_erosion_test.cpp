@@ -114,6 +114,26 @@ TEST(ErosionRule, FanGradientIsExactOnPlanesAndIgnoresTheBorderGap) {
   EXPECT_EQ(fan_gradient(0.0, std::span(half).first(1)).x, 0.0);
 }
 
+// The coefficients give fan_gradient's answer for any heights, the border vertex's gap included.
+TEST(ErosionRule, FanGradientCoefficientsReproduceTheFanGradient) {
+  std::vector<ErosionNeighbour> ring = plane_ring(0.7, 101.0, true);
+  std::vector<ErosionNeighbour> half{{0.1, 1.0, 1.0, 1.0, 0.0}, {0.2, 1.0, 1.0, 0.0, 1.0}, {-0.1, 1.0, 1.0, -1.0, 0.0}};
+  for (std::vector<ErosionNeighbour>* r : {&ring, &half}) {
+    for (std::size_t k = 0; k < r->size(); ++k) (*r)[k].z = 0.05 * std::sin(3.0 * k + 1.0);  // not a plane
+    std::vector<double> cx(r->size()), cy(r->size());
+    fan_gradient_coefficients(*r, cx, cy);
+    const double z_i = 0.02;
+    SurfaceGradient linear;
+    for (std::size_t k = 0; k < r->size(); ++k) {
+      linear.x += cx[k] * ((*r)[k].z - z_i);
+      linear.y += cy[k] * ((*r)[k].z - z_i);
+    }
+    const SurfaceGradient g = fan_gradient(z_i, *r);
+    EXPECT_NEAR(linear.x, g.x, 1e-12);
+    EXPECT_NEAR(linear.y, g.y, 1e-12);
+  }
+}
+
 // The gradient rule's promise: a plane at the critical angle rests in every azimuth, a
 // steeper one does not; the edge rule lets planes between neighbour directions stand steeper.
 TEST(ErosionRule, GradientRuleRestsPlanesAtTheCriticalAngleInEveryAzimuth) {
