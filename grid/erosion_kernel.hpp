@@ -543,9 +543,9 @@ using WindowOf = typename WindowOfStore<Store>::type;
 //
 // Cost: O(span nodes) per pass -- the classing vectorised over the row, one visit per
 // unstable node -- plus O(words of the visited rows) to find the spans and update the set.
-template <int N, bool Gradient, class Store, class Active>
-void dense_pass(Store& store, Active& active, const typename Active::Spans& spans, const ErosionTables& t,
-                ErosionReport& report, double& moved, Lanes lanes) {
+template <int N, bool Gradient, Lanes lanes, class Store, class Active>
+inline void dense_pass_rows(Store& store, Active& active, const typename Active::Spans& spans, const ErosionTables& t,
+                            ErosionReport& report, double& moved) {
   const std::size_t nx = t.layout().nx, ny = t.layout().ny;
   const unsigned pass = active.next_sweep();
   const bool y_up = pass % 2 == 0;
@@ -657,12 +657,12 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     };
     // The same for the nodes a + 3 l of a group whose lanes l (bits of b) transferred, at once
     // (volumes added in visiting order).
-    const auto group_transferred = [&](std::size_t a, unsigned b, const double* given, int lanes, std::size_t transfers)
+    const auto group_transferred = [&](std::size_t a, unsigned b, const double* given, int width, std::size_t transfers)
         __attribute__((always_inline)) {
       // Every lane, branch-free (a loop over the bits of b mispredicts its exit, which flushes
       // the next group's visit the processor had started): a lane that stayed put gave +0.0,
       // and adding +0.0 to the non-negative sum (never -0.0) leaves it unchanged, bit for bit.
-      for (int i = 0; i < lanes; ++i) moved_sum += given[x_up ? i : lanes - 1 - i];
+      for (int i = 0; i < width; ++i) moved_sum += given[x_up ? i : width - 1 - i];
       transfer_count += transfers;
       const std::uint64_t at = kEveryThird[b];  // bit 3 l: node a + 3 l
       or_bits32(moved_row, a, at);
@@ -758,6 +758,27 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
   active.assign_blocks(moved_bits, std::min(first, last), std::max(first, last), col_lo, col_hi);
   moved = moved_sum;
   report.transfers += transfer_count;
+}
+
+// dense_pass_rows in AVX-512 lanes, compiled for AVX-512 as a whole: the eight-node visits and
+// the classing are inlined into the row loop (their results stay in registers), not called.
+template <int N, bool Gradient, class Store, class Active>
+[[gnu::target("avx512f,avx512vl,avx512dq,avx512bw"), gnu::optimize("fp-contract=off"), gnu::flatten]] void
+dense_pass_avx512(Store& store, Active& active, const typename Active::Spans& spans, const ErosionTables& t,
+                  ErosionReport& report, double& moved) {
+  dense_pass_rows<N, Gradient, Lanes::Avx512>(store, active, spans, t, report, moved);
+}
+
+// One dense pass (dense_pass_rows) in the given lanes.
+template <int N, bool Gradient, class Store, class Active>
+void dense_pass(Store& store, Active& active, const typename Active::Spans& spans, const ErosionTables& t,
+                ErosionReport& report, double& moved, Lanes lanes) {
+  if (lanes == Lanes::Avx512)
+    dense_pass_avx512<N, Gradient>(store, active, spans, t, report, moved);
+  else if (lanes == Lanes::Avx2)
+    dense_pass_rows<N, Gradient, Lanes::Avx2>(store, active, spans, t, report, moved);
+  else
+    dense_pass_rows<N, Gradient, Lanes::Sse2>(store, active, spans, t, report, moved);
 }
 
 // Passes until `active` is empty or the budget is spent: ordered, live sweeps of the active
