@@ -87,26 +87,30 @@
 // Cost per visit: 9 height loads (4-neighbour: 5), ~6 floating-point operations per neighbour,
 // plus per transfer one division, and a store per receiving neighbour and one for the centre
 // (visits in vector lanes write every slot: no branch per slot); the gradient rule adds a
-// square root and a division per visit. Measured with AVX-512 (Zen 4,
+// square root and a division per visit. Measured with AVX-512 (Zen 4 in a virtual machine,
 // tests/bench/grid_bench.cpp, edge rule, 8 neighbours, CPU time, medians of nine runs
-// interleaved with the build before the classing was made conditional, the row after next
-// prefetched and the idle counts counted a word at a time; two cores shared with other jobs),
-// M updates/s (an update: one node of a span or one active-set visit): double 96 on the pile
-// (before: 82), 141 on the stroke (126), 186 with every node of 2048^2 active (162; 12.4x the
-// plain scalar sweep in the same runs, before 11.6x); float 48 (42), 65 (60), 91 (86); the
-// gradient rule (AVX-512 lanes only; AVX2 visits it one node at a time), double: 65 on the
-// pile and 92 on the stroke (57, 83). Measured in the AVX2 lanes (callgrind, which runs no
-// AVX-512), instructions per update, double / float, now (before): grid_bench's pile 181 / 228
-// (199 / 258), its stroke 126 / 169 (141 / 193). Four visits in AVX2 lanes take ~320
+// interleaved with the build before the AVX-512 pass was compiled as one function,
+// dense_pass_avx512; two cores shared with other jobs, so figures move by ~5 % between runs),
+// M updates/s (an update: one node of a span or one active-set visit), now (before): double 102
+// on the pile (101), 158 on the stroke (156), 194 with every node of 2048^2 active (196; 12.5x
+// the plain scalar sweep's 15.5 in the same runs); float 51 (49), 70 (67), 99 (95); the
+// gradient rule (AVX-512 lanes only; AVX2 visits it one node at a time), double: 70 on the pile
+// and 101 on the stroke (66, 97). Measured in the AVX2 lanes (callgrind, which runs no AVX-512;
+// the instructions of erode_ordered per update, unchanged by that build), double / float:
+// grid_bench's pile 180 / 227, its stroke 126 / 169. Four visits in AVX2 lanes take ~320
 // instructions (double); classing a row ~16 per node (AVX2, double; ~29 float); rebuilding the
 // active set after a dense pass ~8 per node of the visited columns. Active-set visits add ~100
 // for the set's bookkeeping. Float costs more than its instructions: the rounding carry chains
 // every transferring visit to the one before (float gains least from the wider lanes). Where
-// the time goes with AVX-512 (perf, sampled, share of the timed passes): on the pile, ~60 % in
-// the eight-node visits, ~27 % in the pass's bookkeeping (phases, flags, group results), ~9 %
-// rebuilding the set, ~3 % finding the spans, under 1 % classing (before: ~54 / 23 / 8 / 4 /
-// 11); with every node active, ~59 % visits, ~21 % classing, ~16 % bookkeeping, ~4 % the set
-// (before: ~54 / 24 / 14 / 9). The sparse grid runs the same paths on a RowWindow
+// the time goes with AVX-512 (perf, sampled, share of the timed passes), before the pass was
+// one function: on the pile ~60 % in the eight-node visits, ~25 % in the pass's bookkeeping
+// (phases, flags, group results), ~9 % rebuilding the set, ~2 % finding the spans (rows of ~31
+// nodes, ~5 groups of ~6 lanes each per row, 88 % of the lanes moving, 8 % of the rows
+// classed); with every node active ~61 % visits, ~19 % classing, ~17 % bookkeeping, ~4 % the
+// set (67 % of the nodes visited in lanes, 74 % of those flagged, 66 % moving). Now one
+// function: ~60 % of its samples on vector instructions on the pile, ~69 % with every node
+// active. What was tried beyond that and did not pay: erosion_lanes_avx512.hpp. The sparse
+// grid runs the same paths on a RowWindow
 // (row_window.hpp): three rows copied in and the changed heights written back per row, O(span)
 // each.
 #include <algorithm>
@@ -760,8 +764,11 @@ inline void dense_pass_rows(Store& store, Active& active, const typename Active:
   report.transfers += transfer_count;
 }
 
-// dense_pass_rows in AVX-512 lanes, compiled for AVX-512 as a whole: the eight-node visits and
-// the classing are inlined into the row loop (their results stay in registers), not called.
+// dense_pass_rows in AVX-512 lanes, compiled for AVX-512 as a whole (flatten): the eight-node
+// visits, the classing and the set's update are inlined into the row loop, not called (measured
+// before / after in this file's header). fp-contract=off as in erosion_lanes_avx512.hpp: the
+// scalar visits inlined here must not be fused into multiply-adds (AVX-512 has them), so every
+// path still computes the same heights bit for bit (tests/unit/grid_dense_pass_test.cpp).
 template <int N, bool Gradient, class Store, class Active>
 [[gnu::target("avx512f,avx512vl,avx512dq,avx512bw"), gnu::optimize("fp-contract=off"), gnu::flatten]] void
 dense_pass_avx512(Store& store, Active& active, const typename Active::Spans& spans, const ErosionTables& t,

@@ -22,13 +22,29 @@
 // neighbour, and where a lane transfers 18 permutes and 9 stores; groups with no transfer
 // write nothing: ~190 vector instructions, of which 36 permutes, and a dependency chain of an
 // estimated ~80 cycles (loads, permutes, the sum over the slots in their order, the division,
-// the stores) that the processor overlaps with the next group's only in part. Visiting two
-// groups in one block of code (to overlap the chains) was tried and measured ~15 % slower
-// (likely register spills, not looked into); keeping a row chunk in the split layout across
-// the three phases, which would halve the permutes, changes the visiting order at the chunk
-// ends (every path and the goldens with it) and is not done. The classing also fetches the row
-// after next into the cache (one prefetch per eight nodes; a hint, no result changes): on
-// 2048^2 nodes its loads of the next row waited on memory for ~45 % of its time before.
+// the stores) that the processor overlaps with the next group's only in part. The classing
+// also fetches the row after next into the cache (one prefetch per eight nodes; a hint, no
+// result changes): on 2048^2 nodes its loads of the next row waited on memory for ~45 % of its
+// time before. The dense pass runs these functions inlined into its row loop
+// (dense_pass_avx512, erosion_kernel.hpp).
+//
+// Tried and not kept (ratios of medians of 5 to 9 interleaved runs to the code kept, double,
+// pile / stroke / every node of 2048^2 active; the machine was shared, so +-5 % is noise):
+// visiting two groups in one block of code, ~15 % slower (an earlier session); keeping a chunk
+// of 22 nodes in registers across its three phases (a chunk-by-chunk order: 36 permutes per
+// chunk instead of per group, no reload between phases, the chunk's last two columns handed to
+// the next in registers) 0.94 / 0.92 / 0.67 -- each chunk waits for the one before, so a row
+// becomes one chain of dependent phases, where phase by phase the groups of a phase are
+// independent and overlap; splitting a row's three rows by column modulo 3 once per row (the
+// same order, the groups' blocks then loaded with no permutes: 12 permutes per 24 columns
+// instead of 36 per group) 0.93 / 0.93 / 0.85; 16 of ~190 vector operations fewer per group
+// (the excess weighted in one masked multiply, the transfers counted from the comparison masks)
+// 0.99 / 0.99 / 1.00; plain rather than masked loads and stores for whole groups 0.96 / 0.88 /
+// 0.88; deferring a phase's near-node flags to its end (the scan for the next group then does
+// not wait on the group before through memory) 0.99 / 1.02 / 0.99; the classing's flags of 64
+// nodes gathered in a register 0.96 / 0.97 / 0.99; BMI2 shifts in the pass 1.01 / 1.03 / 1.01
+// (noise). So neither the permutes nor the arithmetic alone bound a group here; this virtual
+// machine has no hardware counters, and what does was not pinned down.
 // Valgrind runs no AVX-512, so there are no callgrind counts for these paths:
 // erosion_kernel.hpp's header gives their measured throughput.
 #include <immintrin.h>
