@@ -144,8 +144,17 @@ notes); the tables below are this run's.
   mesh, 130-240 ns during a stroke with its splits, against 14-28 ns for the grid's eight-lane visits), and
   a stamp 10-24x (re-triangulating around every pose). A TIN visit reads a ring of scattered vertex records
   in CGAL's pointer-linked triangulation, computes cotangent weights and a fan gradient, and is about 1,500
-  instructions; the grid's is about 150, vectorised. A compact, index-based mesh could narrow the first
-  factor (**our code**, not attempted); the rest is **the method**.
+  instructions; the grid's is about 150, vectorised. Of a visit on the pile (callgrind, 1,360
+  instructions): reading the ring's heights, areas and offsets from scattered vertex records about 260, the
+  rule with its fan gradient and cotangent weights about 500, re-activation and the lists about 430 (the
+  gradient rule re-activates each receiver's ring too, as the grid its 3 x 3 block), refinement checks and
+  splits about 160. Laying out each cached
+  ring's cotangent weights and fan-gradient coefficients once per star (as the cascade's fine level does)
+  was tried: 1,206 instructions a visit on the pile (its step 0.202 -> 0.185 ms, 9 interleaved rounds),
+  but no gain on the trench or `flat_stroke.toml` (stamps re-walk the stars about every ten visits: 0.78 ->
+  0.79 and 0.70 -> 0.71 ms), for the pile's peak memory 119 -> 195 kB (the grid's: 163): not kept. A
+  compact, index-based mesh could narrow the first factor (**our code**, not attempted); the rest is **the
+  method**.
 - **TIN settling after a deep stroke** (`flat_stroke.toml` with `tool.depth_m = 0.2`): was **our code**,
   fixed. The TIN needed 361k settling updates where the grid needs 97k, because the grid settles with a
   coarse-to-fine cascade and the TIN settled with fine passes only, whose diffusive tail (the last quarter
