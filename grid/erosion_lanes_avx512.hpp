@@ -43,8 +43,12 @@
 // 0.88; deferring a phase's near-node flags to its end (the scan for the next group then does
 // not wait on the group before through memory) 0.99 / 1.02 / 0.99; the classing's flags of 64
 // nodes gathered in a register 0.96 / 0.97 / 0.99; BMI2 shifts in the pass 1.01 / 1.03 / 1.01
-// (noise). So neither the permutes nor the arithmetic alone bound a group here; this virtual
-// machine has no hardware counters, and what does was not pinned down.
+// (noise); the sums over the slots as balanced trees (a shorter chain, other roundings)
+// 1.02 / 1.00 / 1.00. So neither the permutes, the arithmetic nor the chain's length bound a
+// group here. A diagnostic (wrong heights, not kept): the groups without their nine stores ran
+// 1.01 / 1.23 / 1.13, so on long rows about a sixth of the time goes with the stores or what
+// they hold up, and on the pile's short rows with the pass's bookkeeping. This virtual machine
+// has no hardware counters; the next step is where those stores stall.
 // Valgrind runs no AVX-512, so there are no callgrind counts for these paths:
 // erosion_kernel.hpp's header gives their measured throughput.
 #include <immintrin.h>
