@@ -223,14 +223,22 @@ notes); the tables below are this run's.
   nodes by bit scans over vector-classed rows and visits up to eight independent nodes at once (columns
   modulo 3; AVX-512 lanes with masked ends, the gradient rule included; AVX2 and SSE2 where the CPU lacks
   them), bit for bit the scalar visits; rows are classed only where that pays, the active set is updated a
-  word at a time: on `grid_bench`'s states 96 M updates/s on the pile and 141 M on the stroke (36-51 four
-  rounds ago, 82 and 126 at this round's start), 186 M with every node of 2048^2 active (162), 12x a plain
-  scalar sweep of the same rule (interleaved medians, 9 rounds). What stops it short of the 100 M on the
-  pile and 250 M all active it aims at: the in-place (Gauss-Seidel) order that the default transfer fraction needs to
-  stay monotone (a Jacobi or four-colour sweep overshoots at f = 0.5), the permutes that gather a 3 x 3
-  block per lane (36 per group of eight; keeping a row chunk in column layout across the three phases
-  would change the visiting order), and, in float, the rounding carry that chains every transfer to the
-  one before: **the method's order**, and permutes our layout could still save.
+  word at a time, and the AVX-512 pass is compiled as one function (visits, classing and set update
+  inlined into the row loop): on `grid_bench`'s states 102-104 M updates/s on the pile and 158-160 M on
+  the stroke (36-51 five rounds ago, 82 and 126 at the start of the last round), 194-197 M with every node of 2048^2
+  active (162 then), 12.5x a plain scalar sweep of the same rule (interleaved medians, +-5 %
+  between runs). That meets the 100 M on the pile, not the 250 M all active. Tried and measured, not
+  kept (ratios pile / stroke / all active): keeping a chunk of a row in registers across its three
+  column phases, which saves the permutes that gather a 3 x 3 block per lane but makes each chunk wait
+  for the one before (0.94 / 0.92 / 0.67); splitting the rows by column modulo 3 once per row (0.93 /
+  0.93 / 0.85); fewer vector operations per group, balanced sums, unmasked loads and stores, deferred
+  flags (0.88-1.02). A diagnostic build without the groups' stores (wrong heights) ran 1.01 / 1.23 /
+  1.13, so on long rows about a sixth of the time goes with the stores; rows 4 KiB apart (power-of-two
+  widths) are not the cause (510 and 2046 nodes wide: 0.99 / 0.99 / 1.02). What stops it short: the
+  in-place (Gauss-Seidel) order that the default transfer fraction needs to stay monotone (a Jacobi or
+  four-colour sweep overshoots at f = 0.5), whose independent visits are a column phase's, and, in
+  float, the rounding carry that chains every transfer to the one before: **the method's order** on
+  this machine, as far as our measurements go.
 - **Grid settling of large grids**: was **our code**, fixed. Fine passes alone are diffusive (passes grow
   about 3.5x per halving of the cell, time as n^1.9); a coarse-to-fine cascade relaxes 2 x 2 blocks of
   blocks with the same kernel, adds each level's change to its children (exact volume, energy never

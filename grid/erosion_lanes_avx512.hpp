@@ -47,8 +47,10 @@
 // 1.02 / 1.00 / 1.00. So neither the permutes, the arithmetic nor the chain's length bound a
 // group here. A diagnostic (wrong heights, not kept): the groups without their nine stores ran
 // 1.01 / 1.23 / 1.13, so on long rows about a sixth of the time goes with the stores or what
-// they hold up, and on the pile's short rows with the pass's bookkeeping. This virtual machine
-// has no hardware counters; the next step is where those stores stall.
+// they hold up, and on the pile's short rows with the pass's bookkeeping. Not 4 KiB aliasing
+// between rows (grid_bench's widths are powers of two): 510 and 2046 nodes wide instead of 512
+// and 2048 ran 0.99 / 0.99 / 1.02. This virtual machine has no hardware counters; the next step
+// is where those stores stall.
 // Valgrind runs no AVX-512, so there are no callgrind counts for these paths:
 // erosion_kernel.hpp's header gives their measured throughput.
 #include <immintrin.h>
