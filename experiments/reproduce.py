@@ -186,7 +186,7 @@ notes); the tables below are this run's.
   is now shared by conductance times excess height, with cotangent weights on a TIN (transport without a
   preferred direction on any triangulation; the regular lattice: 0.05); (2) vertex pairs under a
   millimetre apart throttled the flow (above). Now: RMSE 54 um (1.5x the grid's 35), flank 29.5 degrees,
-  roundness 0.022, with 339 vertices (0.5x the grid's memory), step 4.1x the grid's. Where the error is
+  roundness 0.022, with 339 vertices (0.5x the grid's memory), step 4.1-4.3x the grid's. Where the error is
   (share of the squared error): flank 48 %, toe 33 %, apex 6 %, outside the pile 14 % (the grid: 58, 39,
   4, 0); the flank's 0.5-degree deficit alone accounts for 18 um. Outside the pile, a split's volume
   give-back lowers the new vertex by up to 0.3 mm, leaving pits below the bed where no tool went; spreading
