@@ -1,8 +1,9 @@
 // Grid back-end benchmarks: erosion throughput (node updates per second: one update is one
 // evaluation of the rule at one node) on realistic active sets of a 512 x 512 grid, on a
 // 2048 x 2048 grid with every node active, against a plain scalar in-place sweep of the same
-// rule in the same run (BM_ReferenceSweep), and stamp cost against tool area; float and double;
-// the pile and stroke also with the gradient rule.
+// rule in the same run (BM_ReferenceSweep), against a vectorised two-pass (Jacobi) sweep at its
+// monotone fraction (BM_JacobiSweep), time to rest of both orders (BM_Settle*), and stamp cost
+// against tool area; float and double; the pile and stroke also with the gradient rule.
 //
 //   build/<dir>/tests/grid_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 //       --benchmark_enable_random_interleaving=true
@@ -235,6 +236,155 @@ BENCHMARK(BM_ReferenceSweep<double>)
     ->ArgName("passes")
     ->Arg(4)
     ->Unit(benchmark::kMillisecond);
+
+// The two-pass (Jacobi) sweep that erosion_kernel.hpp argues against ("Why not a Jacobi
+// sweep"), vectorised, as a measured alternative: every node's transfers computed from the same
+// old heights (edge rule, 8 neighbours, every node a full cell; a halo of high nodes that never
+// give or receive), applied together. Monotone in energy only for f <= 2 / (N + 1) = 2 / 9, so it
+// runs at that fraction: the comparison is of sweeps that both settle. Pass A: per node, the
+// height it gives, out = f / 2 * its largest pair excess, and share = out / the sum of its pair
+// excesses (0 where stable); pass B: z_i += -out_i + sum_j share_j e_ji, e_ji the excess of j over
+// i from the old heights (the same value pass A summed at j, so volume is conserved exactly up
+// to rounding). Both passes are plain stencil loops the compiler vectorises (target_clones).
+class JacobiSweep {
+ public:
+  JacobiSweep(const std::vector<double>& heights, std::size_t nx, std::size_t ny, double cell, const sb::ErosionRule& r)
+      : w_(nx + 2), h_(ny + 2), z_(w_ * h_, kHalo), next_(z_), out_(z_.size(), 0.0), share_(z_.size(), 0.0) {
+    for (std::size_t iy = 0; iy < ny; ++iy)
+      for (std::size_t ix = 0; ix < nx; ++ix) z_[(iy + 1) * w_ + ix + 1] = heights[iy * nx + ix];
+    next_ = z_;
+    for (int s = 0; s < 8; ++s) {
+      const double d = s < 4 ? cell : cell * std::numbers::sqrt2;
+      p_.allowed[s] = d * r.tan_critical;
+      p_.settle[s] = d * r.tan_settle;
+    }
+    p_.half_fraction = 0.5 * (2.0 / 9.0);
+  }
+  // One pass; returns the number of nodes that gave.
+  std::size_t pass() {
+    std::size_t gave = 0;
+    const auto w = static_cast<std::ptrdiff_t>(w_);
+    for (std::size_t iy = 1; iy + 1 < h_; ++iy)
+      gave += give_row(p_, z_.data() + iy * w_, out_.data() + iy * w_, share_.data() + iy * w_, w_ - 2, w);
+    for (std::size_t iy = 1; iy + 1 < h_; ++iy)
+      take_row(p_, z_.data() + iy * w_, share_.data() + iy * w_, out_.data() + iy * w_, next_.data() + iy * w_, w_ - 2,
+               w);
+    z_.swap(next_);
+    return gave;
+  }
+  double volume() const {
+    double v = 0.0;
+    for (std::size_t iy = 1; iy + 1 < h_; ++iy)
+      for (std::size_t ix = 1; ix + 1 < w_; ++ix) v += z_[iy * w_ + ix];
+    return v;
+  }
+
+ private:
+  static constexpr double kHalo = 1e30;  // never gives (no drop), never receives (share 0)
+  struct Stencil8 {
+    double allowed[8], settle[8];  // d tan_critical, d tan_settle per direction (axes 0-3, diagonals 4-7)
+    double half_fraction;
+  };
+  // The excess height of a drop over a run: drop - allowed where drop > settle, else 0.
+  static double excess(double drop, double allowed, double settle) { return drop > settle ? drop - allowed : 0.0; }
+  // Row of n real nodes at z[1..n] (z[0] and z[n + 1]: the halo); the rows above and below are
+  // w apart. The eight neighbours written out, so the compiler vectorises along the row.
+  __attribute__((target_clones("avx512f", "avx2", "default"))) static std::size_t give_row(
+      const Stencil8& p, const double* __restrict z, double* __restrict out, double* __restrict share, std::size_t n,
+      std::ptrdiff_t w) {
+    const double* __restrict up = z + w;
+    const double* __restrict down = z - w;
+    const double a0 = p.allowed[0], s0 = p.settle[0], a1 = p.allowed[4], s1 = p.settle[4];
+    std::size_t gave = 0;
+    for (std::size_t x = 1; x <= n; ++x) {
+      const double zi = z[x];
+      const double e[8] = {excess(zi - z[x + 1], a0, s0),    excess(zi - z[x - 1], a0, s0),
+                           excess(zi - up[x], a0, s0),       excess(zi - down[x], a0, s0),
+                           excess(zi - up[x + 1], a1, s1),   excess(zi - up[x - 1], a1, s1),
+                           excess(zi - down[x + 1], a1, s1), excess(zi - down[x - 1], a1, s1)};
+      const double sum = ((e[0] + e[1]) + (e[2] + e[3])) + ((e[4] + e[5]) + (e[6] + e[7]));
+      const double largest = std::max(std::max(std::max(e[0], e[1]), std::max(e[2], e[3])),
+                                      std::max(std::max(e[4], e[5]), std::max(e[6], e[7])));
+      const double o = p.half_fraction * largest;
+      out[x] = o;
+      share[x] = sum > 0.0 ? o / sum : 0.0;
+      gave += sum > 0.0 ? 1 : 0;
+    }
+    return gave;
+  }
+  __attribute__((target_clones("avx512f", "avx2", "default"))) static void take_row(
+      const Stencil8& p, const double* __restrict z, const double* __restrict share, const double* __restrict out,
+      double* __restrict next, std::size_t n, std::ptrdiff_t w) {
+    const double *up = z + w, *down = z - w, *sup = share + w, *sdown = share - w;
+    const double a0 = p.allowed[0], s0 = p.settle[0], a1 = p.allowed[4], s1 = p.settle[4];
+    for (std::size_t x = 1; x <= n; ++x) {
+      const double zi = z[x];  // each neighbour's drop towards x, times its share
+      const double in =
+          (share[x + 1] * excess(z[x + 1] - zi, a0, s0) + share[x - 1] * excess(z[x - 1] - zi, a0, s0)) +
+          (sup[x] * excess(up[x] - zi, a0, s0) + sdown[x] * excess(down[x] - zi, a0, s0)) +
+          (sup[x + 1] * excess(up[x + 1] - zi, a1, s1) + sup[x - 1] * excess(up[x - 1] - zi, a1, s1)) +
+          (sdown[x + 1] * excess(down[x + 1] - zi, a1, s1) + sdown[x - 1] * excess(down[x - 1] - zi, a1, s1));
+      next[x] = zi + (in - out[x]);
+    }
+  }
+  std::size_t w_, h_;
+  std::vector<double> z_, next_, out_, share_;
+  Stencil8 p_{};
+};
+
+// Jacobi passes over every node of the 2048^2 all-active state (updates: nodes x passes).
+void BM_JacobiSweep(benchmark::State& state) {
+  const GridLayout layout = big_layout();
+  time_all_active<double>(
+      state,
+      [&layout](const GridTerrain<double>& start) {
+        return JacobiSweep(start.heights().heights(), layout.nx, layout.ny, kCell, rule());
+      },
+      [&layout](JacobiSweep& j, int passes, const sb::ErosionRule&) {
+        for (int p = 0; p < passes; ++p) benchmark::DoNotOptimize(j.pass());
+        return static_cast<std::size_t>(passes) * layout.nodes();
+      });
+}
+BENCHMARK(BM_JacobiSweep)->Name("BM_JacobiSweep<double>")->ArgName("passes")->Arg(4)->Unit(benchmark::kMillisecond);
+
+// Time to rest from the dunes (512 x 512, every node active, fine passes only): the kernel's
+// Gauss-Seidel passes at the scenes' fraction 0.5 against the Jacobi sweep at its monotone 2/9.
+// One iteration each; counters: passes, node updates, and the volume's relative change.
+GridTerrain<double> small_dunes() {
+  GridTerrain<double> t(GridLayout::covering({{0.0, 0.0}, {kSize, kSize}}, kCell), dunes, 8, 2);
+  t.activate_all();
+  t.set_multires(false);
+  return t;
+}
+void BM_SettleGaussSeidel(benchmark::State& state) {
+  for (auto _ : state) {
+    state.PauseTiming();
+    GridTerrain<double> t = small_dunes();
+    const double v0 = t.volume();
+    state.ResumeTiming();
+    const sb::ErosionReport r = t.erode(rule(), {.max_passes = 1000000});
+    state.counters["passes"] = r.passes;
+    state.counters["updates"] = static_cast<double>(r.updates);
+    state.counters["settled"] = r.active == 0 ? 1 : 0;
+    state.counters["volume_rel"] = t.volume() / v0 - 1.0;
+  }
+}
+BENCHMARK(BM_SettleGaussSeidel)->Iterations(1)->Unit(benchmark::kMillisecond);
+void BM_SettleJacobi(benchmark::State& state) {
+  const GridTerrain<double> start = small_dunes();
+  for (auto _ : state) {
+    state.PauseTiming();
+    JacobiSweep j(start.heights().heights(), start.layout().nx, start.layout().ny, kCell, rule());
+    const double v0 = j.volume();
+    state.ResumeTiming();
+    int passes = 0;
+    while (passes < 1000000 && j.pass() > 0) ++passes;
+    state.counters["passes"] = passes;
+    state.counters["updates"] = static_cast<double>(passes) * static_cast<double>(start.layout().nodes());
+    state.counters["volume_rel"] = j.volume() / v0 - 1.0;
+  }
+}
+BENCHMARK(BM_SettleJacobi)->Iterations(1)->Unit(benchmark::kMillisecond);
 
 // One stamp of a disk of the given radius (in cells) on fresh sand: stamps walk a lattice
 // of positions far enough apart that none overlaps the last; the grid is reset (untimed)
