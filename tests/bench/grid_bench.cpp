@@ -249,15 +249,14 @@ BENCHMARK(BM_ReferenceSweep<double>)
 class JacobiSweep {
  public:
   JacobiSweep(const std::vector<double>& heights, std::size_t nx, std::size_t ny, double cell, const sb::ErosionRule& r)
-      : w_(nx + 2), h_(ny + 2), z_(w_ * h_, kHalo), next_(z_), out_(z_.size(), 0.0), share_(z_.size(), 0.0) {
+      : w_(nx + 2), h_(ny + 2), z_(w_ * h_, kHalo), out_(z_.size(), 0.0), share_(z_.size(), 0.0) {
     for (std::size_t iy = 0; iy < ny; ++iy)
       for (std::size_t ix = 0; ix < nx; ++ix) z_[(iy + 1) * w_ + ix + 1] = heights[iy * nx + ix];
-    next_ = z_;
-    for (int s = 0; s < 8; ++s) {
-      const double d = s < 4 ? cell : cell * std::numbers::sqrt2;
-      p_.allowed[s] = d * r.tan_critical;
-      p_.settle[s] = d * r.tan_settle;
-    }
+    next_ = z_;  // (the halo stays in both)
+    p_.allowed_axis = cell * r.tan_critical;
+    p_.settle_axis = cell * r.tan_settle;
+    p_.allowed_diagonal = std::numbers::sqrt2 * cell * r.tan_critical;
+    p_.settle_diagonal = std::numbers::sqrt2 * cell * r.tan_settle;
     p_.half_fraction = 0.5 * (2.0 / 9.0);
   }
   // One pass; returns the number of nodes that gave.
@@ -282,7 +281,8 @@ class JacobiSweep {
  private:
   static constexpr double kHalo = 1e30;  // never gives (no drop), never receives (share 0)
   struct Stencil8 {
-    double allowed[8], settle[8];  // d tan_critical, d tan_settle per direction (axes 0-3, diagonals 4-7)
+    // d tan_critical and d tan_settle along the axes and the diagonals.
+    double allowed_axis, settle_axis, allowed_diagonal, settle_diagonal;
     double half_fraction;
   };
   // The excess height of a drop over a run: drop - allowed where drop > settle, else 0.
@@ -294,7 +294,7 @@ class JacobiSweep {
       std::ptrdiff_t w) {
     const double* __restrict up = z + w;
     const double* __restrict down = z - w;
-    const double a0 = p.allowed[0], s0 = p.settle[0], a1 = p.allowed[4], s1 = p.settle[4];
+    const double a0 = p.allowed_axis, s0 = p.settle_axis, a1 = p.allowed_diagonal, s1 = p.settle_diagonal;
     std::size_t gave = 0;
     for (std::size_t x = 1; x <= n; ++x) {
       const double zi = z[x];
@@ -316,7 +316,7 @@ class JacobiSweep {
       const Stencil8& p, const double* __restrict z, const double* __restrict share, const double* __restrict out,
       double* __restrict next, std::size_t n, std::ptrdiff_t w) {
     const double *up = z + w, *down = z - w, *sup = share + w, *sdown = share - w;
-    const double a0 = p.allowed[0], s0 = p.settle[0], a1 = p.allowed[4], s1 = p.settle[4];
+    const double a0 = p.allowed_axis, s0 = p.settle_axis, a1 = p.allowed_diagonal, s1 = p.settle_diagonal;
     for (std::size_t x = 1; x <= n; ++x) {
       const double zi = z[x];  // each neighbour's drop towards x, times its share
       const double in =
