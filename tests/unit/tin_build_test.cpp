@@ -24,7 +24,7 @@ TEST(TinBuild, FlatSceneIsFourCornersAndTwoTriangles) {
   EXPECT_NEAR(t->volume(), 0.5 * 0.5 * 0.1, 1e-15);
   EXPECT_DOUBLE_EQ(t->height({0.123, 0.456}), 0.1);
   EXPECT_EQ(t->max_slope_deg(), 0.0);
-  SB_EXPECT_CHECK_OK(*t);
+  SB_EXPECT_TIN_OK(*t);
 }
 
 TEST(TinBuild, GreedyInsertionFollowsTheTerrainsDetail) {
@@ -33,8 +33,8 @@ TEST(TinBuild, GreedyInsertionFollowsTheTerrainsDetail) {
   const HeightField field = HeightField::from_scene(fine);
   auto t_fine = make_tin_terrain(fine, field);
   auto t_coarse = make_tin_terrain(coarse, field);
-  SB_EXPECT_CHECK_OK(*t_fine);
-  SB_EXPECT_CHECK_OK(*t_coarse);
+  SB_EXPECT_TIN_OK(*t_fine);
+  SB_EXPECT_TIN_OK(*t_coarse);
   const std::size_t n_fine = t_fine->stats().vertices, n_coarse = t_coarse->stats().vertices;
   EXPECT_GT(n_coarse, 20u);
   EXPECT_GT(n_fine, 2 * n_coarse) << "a 4x tighter tolerance needs more vertices";
@@ -86,7 +86,7 @@ tolerance_m = 0.0005
   const Scene s = parse_scene(text, "heightmap-test");
   const HeightField field = HeightField::from_scene(s);
   auto t = make_tin_terrain(s, field);
-  SB_EXPECT_CHECK_OK(*t);
+  SB_EXPECT_TIN_OK(*t);
   EXPECT_GT(t->stats().vertices, 10u);
   EXPECT_LT(t->stats().vertices, 33u * 33u);
   for (std::size_t r = 0; r < 33; ++r)
@@ -137,7 +137,7 @@ TEST(TinBuild, FromPointsIsTheDelaunayTriangulationOfThePoints) {
   const Scene s = scene();
   const auto pts = jittered_points(400, 0.5, 11, [](const Vec2& p) { return 0.1 + 0.05 * p.x(); });
   auto t = make_tin_terrain_from_points(s, pts);
-  SB_EXPECT_CHECK_OK(*t);
+  SB_EXPECT_TIN_OK(*t);
   EXPECT_EQ(t->stats().vertices, 404u);
   const SurfaceMesh m = t->mesh();
   EXPECT_EQ(m.triangles.size(), t->stats().triangles);
@@ -150,7 +150,7 @@ TEST(TinBuild, DelaunayAwayFromConstraintsAfterStamps) {
   const auto pts = jittered_points(900, 0.5, 5, [](const Vec2& p) { return 0.1 + 0.02 * std::sin(20.0 * p.x()); });
   auto t = make_tin_terrain_from_points(s, pts);
   for (int k = 0; k < 5; ++k) t->stamp(stamp_at(s, {0.2 + 0.01 * k, 0.25}, 0.09, {1, 0}, k));
-  SB_EXPECT_CHECK_OK(*t);  // includes CGAL's constrained Delaunay test of every edge
+  SB_EXPECT_TIN_OK(*t);  // includes CGAL's constrained Delaunay test of every edge
   // Locally Delaunay across every unconstrained edge (equivalent to constrained Delaunay).
   const SurfaceMesh m = t->mesh();
   ASSERT_GT(m.constrained_edges.size(), 0u);
@@ -198,7 +198,7 @@ TEST(TinBuild, HeightInterpolatesAndRefusesNonFiniteQueries) {
   // Outside the domain the height is the border's.
   EXPECT_NEAR(t->height({-1.0, 0.25}), t->height({0.0, 0.25}), 1e-15);
   EXPECT_THROW(t->height({std::nan(""), 0.1}), InputError);
-  SB_EXPECT_CHECK_OK(*t);
+  SB_EXPECT_TIN_OK(*t);
 }
 
 TEST(TinBuild, WalksFromTheLastLocatedFaceAreShort) {

@@ -41,7 +41,7 @@ TEST(TinErosion, TransfersConserveVolumeExactly) {
     EXPECT_NEAR(t->volume(), v0, 1e-14 * v0) << "pass block " << k;
   }
   EXPECT_GT(moved, 1e-6);
-  SB_EXPECT_CHECK_OK(*t);
+  SB_EXPECT_TIN_OK(*t);
 }
 
 TEST(TinErosion, RelaxesToTheCriticalAngleAndEmptiesTheActiveSet) {
@@ -50,7 +50,7 @@ TEST(TinErosion, RelaxesToTheCriticalAngleAndEmptiesTheActiveSet) {
   activate(*t, s);
   EXPECT_GT(t->max_slope_deg(), 35.0);
   ASSERT_TRUE(relax(*t, s));
-  SB_EXPECT_CHECK_OK(*t);
+  SB_EXPECT_TIN_OK(*t);
   EXPECT_EQ(t->stats().active, 0u);
   EXPECT_LE(t->max_slope_deg(), 30.0 + s.erosion.settle_tolerance_deg + 1e-9);
   // Settled means settled: one more pass moves nothing.
@@ -93,10 +93,10 @@ TEST(TinErosion, APileOnTwoTrianglesRefinesAndRelaxesToACone) {
   const double v0 = t->volume();
   for (const ToolStamp& st : schedule_of(s).stamps) {
     step(*t, s, st);
-    SB_ASSERT_CHECK_OK(*t);
+    SB_ASSERT_TIN_OK(*t);
   }
   ASSERT_TRUE(relax(*t, s));
-  SB_EXPECT_CHECK_OK(*t);
+  SB_EXPECT_TIN_OK(*t);
   EXPECT_GT(t->stats().vertices, 200u) << "the mesh refined where the sand went";
   EXPECT_LE(t->max_slope_deg(), 30.0 + s.erosion.settle_tolerance_deg + 1e-9);
   // The ideal cone of 2e-5 m^3 at 30 degrees: radius 32.1 mm, height 18.5 mm.
@@ -136,12 +136,12 @@ void pour_pile(const std::vector<std::string>& keys, PileOutcome& out) {
   for (const ToolStamp& st : schedule_of(s).stamps) {
     step(*t, s, st);
     added += st.pour_volume_m3;
-    SB_ASSERT_CHECK_OK(*t);
+    SB_ASSERT_TIN_OK(*t);
     EXPECT_NEAR(t->volume(), v0 + added, 1e-13 * v0);
   }
   out.poured_vertices = t->stats().vertices;
   EXPECT_TRUE(relax(*t, s));
-  SB_EXPECT_CHECK_OK(*t);
+  SB_EXPECT_TIN_OK(*t);
   EXPECT_NEAR(t->volume(), v0 + added, 1e-13 * v0);
   out.vertices = t->stats().vertices;
   out.top = t->height({0.15, 0.15}) - 0.05;
@@ -211,7 +211,7 @@ TEST(TinErosion, CurvatureRefinedTrenchSettlesWithoutSlivers) {
     const double v0 = t->volume();
     for (const ToolStamp& st : schedule_of(s).stamps) step(*t, s, st);
     EXPECT_TRUE(relax(*t, s, 20000)) << rule;
-    SB_EXPECT_CHECK_OK(*t);
+    SB_EXPECT_TIN_OK(*t);
     // Settled: no facet steeper than critical + erosion.settle_tolerance_deg (0.1).
     EXPECT_LT(t->max_slope_deg(), 30.1 + 1e-6) << rule;
     EXPECT_NEAR(t->volume(), v0, 1e-12 * v0);

@@ -61,29 +61,29 @@ TEST(TinMemory, BytesMatchAllocatorAccounting) {
 TEST(TinCheck, HoldsAfterEveryOperation) {
   const Scene s = scene(kDunesScene, {"tin.conserve_volume=true"});
   auto t = make(s);
-  SB_ASSERT_CHECK_OK(*t);
+  SB_ASSERT_TIN_OK(*t);
   const ErosionRule rule = rule_of(s);
   int k = 0;
   for (const ToolStamp& st : schedule_of(s).stamps) {
     t->stamp(st);
-    SB_ASSERT_CHECK_OK(*t);
+    SB_ASSERT_TIN_OK(*t);
     t->erode(rule, ErosionBudget{4});
-    SB_ASSERT_CHECK_OK(*t);
+    SB_ASSERT_TIN_OK(*t);
     t->simplify(SimplifyParams{0.4});
-    SB_ASSERT_CHECK_OK(*t);
+    SB_ASSERT_TIN_OK(*t);
     if (k++ % 5 == 0) {
       ToolStamp pour;
       pour.pose.xy = st.pose.xy + Vec2(0.03, 0.0);
       pour.pour_volume_m3 = 2e-7;
       pour.pour_radius_m = 0.004;
       t->stamp(pour);
-      SB_ASSERT_CHECK_OK(*t);
+      SB_ASSERT_TIN_OK(*t);
     }
   }
   Raster raster = Raster::covering(s.domain.box(), 0.01);
   t->sample(raster);
   t->mesh();
-  SB_ASSERT_CHECK_OK(*t);
+  SB_ASSERT_TIN_OK(*t);
 }
 
 }  // namespace

@@ -183,7 +183,7 @@ TEST(TinSettleCascade, TinSettlesToReposeWithFewerUpdates) {
     const Settled fine = stroke_and_settle(s, kCascadeMinPasses - 1);
     for (const Settled* r : {&cascade, &fine}) {
       ASSERT_TRUE(r->settled);
-      SB_EXPECT_CHECK_OK(*r->terrain);
+      SB_EXPECT_TIN_OK(*r->terrain);
       EXPECT_NEAR(r->terrain->volume(), r->volume_before, 1e-12 * r->volume_before);
       EXPECT_LE(r->terrain->max_slope_deg(), 30.0 + s.erosion.settle_tolerance_deg + 1e-9);
       EXPECT_EQ(r->terrain->erode(rule_of(s), ErosionBudget{1}).transfers, 0u);  // at repose

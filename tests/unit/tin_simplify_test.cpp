@@ -65,7 +65,7 @@ TEST(TinSimplify, OnlyFlatVerticesAreRemoved) {
     const SurfaceMesh before = t->mesh();
     const std::map<Key, double> angles = edge_angles(before);
     const SimplifyReport r = t->simplify(SimplifyParams{0.4});
-    SB_ASSERT_CHECK_OK(*t);
+    SB_ASSERT_TIN_OK(*t);
     EXPECT_LE(r.removed, r.candidates);
     EXPECT_GE(r.detect_s, 0.0);
     EXPECT_GE(r.remove_s, 0.0);
@@ -100,7 +100,7 @@ TEST(TinSimplify, AFlatStrokeEndsWithFewVertices) {
   auto t = make(s);
   for (const ToolStamp& st : schedule_of(s).stamps) step(*t, s, st);
   ASSERT_TRUE(relax(*t, s));
-  SB_EXPECT_CHECK_OK(*t);
+  SB_EXPECT_TIN_OK(*t);
   // Vertices stay in proportion to the trace (the paper's Figure 9), far below a grid's.
   EXPECT_LT(t->stats().vertices, 3000u);
 }
@@ -122,7 +122,7 @@ TEST(TinSimplify, ConserveVolumeSpreadsTheRemovalsChange) {
   for (int round = 0; round < 50; ++round) removed += t->simplify(SimplifyParams{2.0}).removed;
   EXPECT_GT(removed, 50u);
   EXPECT_NEAR(t->volume(), v0, 1e-13 * v0);
-  SB_EXPECT_CHECK_OK(*t);
+  SB_EXPECT_TIN_OK(*t);
 }
 
 TEST(TinSimplify, CoarseningRemovesSettledNearPlanarVerticesAndKeepsTheVolume) {
@@ -147,7 +147,7 @@ TEST(TinSimplify, CoarseningRemovesSettledNearPlanarVerticesAndKeepsTheVolume) {
       t->erode(rule_of(s), ErosionBudget{8});  // nothing to move: the touched vertices settle
       removed += t->simplify(SimplifyParams{0.4}).removed;
     }
-    SB_EXPECT_CHECK_OK(*t);
+    SB_EXPECT_TIN_OK(*t);
     EXPECT_NEAR(t->volume(), v0, 1e-12 * v0);
     if (coarsen) {
       EXPECT_GT(removed, n0 / 10) << "settled, near-planar vertices go";

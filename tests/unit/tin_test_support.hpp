@@ -74,4 +74,8 @@ inline void step(Terrain& t, const Scene& s, const ToolStamp& st) {
   t.simplify(SimplifyParams{s.tin.alpha_flat_deg});
 }
 
+// The TIN tests' names for SB_EXPECT_CHECK_OK and SB_ASSERT_CHECK_OK (terrain_test_support.hpp).
+#define SB_EXPECT_TIN_OK(terrain) SB_EXPECT_CHECK_OK(terrain)
+#define SB_ASSERT_TIN_OK(terrain) SB_ASSERT_CHECK_OK(terrain)
+
 }  // namespace sb::tin::test
