@@ -180,9 +180,9 @@ bool TinTerrain::refine_crease(VertexHandle v) {
 }
 
 ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& budget) {
-  // The fan gradient is too coarse an estimate to cap drops by (common/erosion.hpp).
+  // Drops capped by the steepest facet, where the sand comes to rest (common/erosion.hpp).
   ErosionRule rule = given;
-  rule.cap_drop = false;
+  rule.cap_drop = budget.settling;
   if (!std::isfinite(rule.tan_critical) || !std::isfinite(rule.tan_settle) || !std::isfinite(rule.fraction) ||
       rule.tan_critical < 0.0 || rule.fraction < 0.0)
     throw InputError("erosion: the rule's slopes and fraction must be finite and non-negative");
@@ -191,7 +191,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
   // The gradient rule's input: the area-weighted facet gradients of v's star (gather_neighbours
   // lists the neighbours counter-clockwise, so consecutive ones span v's triangles).
   const auto gradient_at = [&](VertexHandle v) {
-    return rule.needs_gradient() ? fan_gradient(v->point().z(), nbrs()) : SurfaceGradient{};
+    return rule.needs_gradient() ? fan_gradient(v->point().z(), nbrs(), rule.cap_drop) : SurfaceGradient{};
   };
   // Curvature refinement (tin.curvature_tolerance_m), unless it waits for the sand to settle.
   const bool creases = fine_m_ < refine_m_ && (budget.settling || spec_.curvature_while_stamping);

@@ -215,11 +215,13 @@ void relax_fine(std::span<double> z, std::span<const double> area, std::span<con
     for (std::uint32_t k = b; k < e; ++k) {
       const double zk = z[ring[k]];
       nbrs[k].z = zk;
-      if (!gradient) continue;
+      if (!gradient || rule.cap_drop) continue;
       g.x += gcx[k] * (zk - z[i]);
       g.y += gcy[k] * (zk - z[i]);
     }
     const std::span<const ErosionNeighbour> fan(nbrs.data() + b, e - b);
+    // Capped drops need the steepest facet: the facets one by one, as TinTerrain::erode does.
+    if (gradient && rule.cap_drop) g = fan_gradient(z[i], fan, true);
     out.resize(fan.size());
     const double total =
         erosion_transfers(z[i], area[i], g, fan, rule, out, NeighbourLayout::Fan, conductance.data() + b);

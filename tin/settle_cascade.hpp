@@ -29,8 +29,9 @@
 // Then the fine level (CascadeOptions::fine_level): the vertices whose whole ring lies in the
 // region are relaxed with the fine rule exactly as TinTerrain::erode applies it (the rule's
 // kind, the fan gradient, cotangent conductances over the counter-clockwise ring, the same
-// re-activation), over plain arrays whose offsets, distances, areas, conductances and fan
-// gradient coefficients are laid out once: the diffusive tail at the mesh's scale at about 700
+// re-activation; drops capped by the steepest facet as the TIN caps them at rest, the fan's
+// facets then computed one by one), over plain arrays whose offsets, distances, areas,
+// conductances and fan gradient coefficients are laid out once: the diffusive tail at the mesh's scale at about 700
 // instructions a visit instead of about 1500. Region vertices have no edge longer than the
 // refinement length, so the fine passes would split nothing there. The TIN runs no cascade with
 // curvature refinement (tin.curvature_tolerance_m > 0; settle_region.cpp): its crease splits

@@ -191,6 +191,39 @@ TEST(ErosionRule, CapDropCountsAtMostTheGradientsDrop) {
   EXPECT_NEAR(full, 0.5 * (0.4 * d - 0.5 * d * std::tan(deg_to_rad(30.0))) * a, 1e-18);
 }
 
+// The TIN's cap (ErosionRule::cap_drop with SurfaceGradient::steepest, the steepest facet):
+// on a plane every facet has the plane's slope, so it caps as the gradient does; on a cone's
+// flank, whose level lines bend away from the apex, sideways neighbours lie lower than the slope
+// predicts, and uncapped that curvature counts as slope: a vertex 20 mm from the apex with
+// neighbours 7 mm away sent 2-6.5x what a plane of the same slope sends, capped 1.3-2.8x.
+TEST(ErosionRule, SteepestFacetCapsTheConesCurvature) {
+  for (double az : {0.0, 40.0, 135.0}) {
+    const auto ring = plane_ring(0.6, az, true);
+    const SurfaceGradient g = fan_gradient(0.0, ring, true);
+    EXPECT_NEAR(g.steepest, 0.6, 1e-12) << az;
+    EXPECT_NEAR(g.steepest, std::hypot(g.x, g.y), 1e-12) << az;
+    EXPECT_EQ(fan_gradient(0.0, ring).steepest, -1.0);  // not asked for
+  }
+  ErosionRule rule = rule30();
+  for (double deg : {30.5, 31.0, 32.0}) {
+    const double t = std::tan(deg_to_rad(deg)), apex = 0.02, d = 0.007;
+    std::vector<ErosionNeighbour> cone;
+    for (int k = 0; k < 7; ++k) {
+      const double a = 2.0 * std::numbers::pi * k / 7.0 + 0.2, dx = d * std::cos(a), dy = d * std::sin(a);
+      cone.push_back({-t * (std::hypot(apex + dx, dy) - apex), d, 4e-5, dx, dy});
+    }
+    std::vector<double> out(cone.size());
+    rule.cap_drop = false;
+    const double uncapped = erosion_transfers(0.0, 4e-5, fan_gradient(0.0, cone), cone, rule, out);
+    rule.cap_drop = true;
+    const SurfaceGradient g = fan_gradient(0.0, cone, true);
+    EXPECT_GT(g.steepest, t) << deg;  // a facet with an inner vertex is steeper than the cone
+    const double capped = erosion_transfers(0.0, 4e-5, g, cone, rule, out);
+    EXPECT_GT(capped, 0.0) << deg;  // steeper than critical: it still flows
+    EXPECT_LT(capped, 0.7 * uncapped) << deg;
+  }
+}
+
 // erosion_transfers takes the gradient rule's branch exactly where sqrt(gx^2 + gy^2) > tan_settle,
 // as the grid kernel decides it (grid/erosion_kernel.hpp), also within rounding of the threshold.
 TEST(ErosionRule, GradientRuleDecidesSteepnessAsTheGridKernelDoes) {
