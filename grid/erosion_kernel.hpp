@@ -566,7 +566,8 @@ inline void dense_pass_rows(Store& store, Active& active, const typename Active:
   moved_bits.reserve((spans.y1 - spans.y0 + 3) * words);  // the members' rows and one each way, as a rule
   // A store without contiguous heights that copies rows (the sparse grid) runs each row on a
   // RowWindow of the three rows it touches (node k = nx + ix of the row), as a contiguous
-  // store runs it on its own heights (node k = iy * nx + ix).
+  // store runs it on its own heights (node k = iy * nx + ix). The window slides from row to
+  // row (load) and writes the rows it still holds back after the last one (flush).
   constexpr bool kWindowed = requires { store.read_row(0, 0, 0, nullptr); };
   [[maybe_unused]] WindowOf<Store> window(store, nx, ny);
   auto& rs = [&]() -> auto& {
@@ -748,7 +749,6 @@ inline void dense_pass_rows(Store& store, Active& active, const typename Active:
     } else {
       while (x0 > 0 && bit_at(moved_row, x0)) visit(--x0);
     }
-    if constexpr (kWindowed) window.store_back();
     report.updates += x1 - x0 + 1;
     col_lo = std::min(col_lo, x0), col_hi = std::max(col_hi, x1);
     if (row_lo <= row_hi) prev_lo = row_lo, prev_hi = row_hi;
@@ -758,6 +758,7 @@ inline void dense_pass_rows(Store& store, Active& active, const typename Active:
     const std::size_t span = x1 - x0 + 1;
     class_row = (classed ? span - std::min(covered, span) : idle) * 8 > span;
   }
+  if constexpr (kWindowed) window.flush();  // the rows still held, back into the store
   // Rows in increasing y for the set.
   const std::size_t last = y_up ? first + visited_rows - 1 : first - (visited_rows - 1);
   if (!y_up)
