@@ -36,9 +36,9 @@
 //
 // Store: value_type, kRounds, read_row(iy, x0, x1, out), write_changed(iy, x0, x1, values,
 // before), carry() (SparseHeights).
-// Memory: 2 x kRows x nx heights (2 x 16 x nx; double, nx = 161: 41 KiB), allocated and
-// zeroed per window (per dense pass). Costs: over a run of adjacent visited rows, each row is
-// read once and written back once (O(its columns)): over the union of the spans of the (at
+// Memory: 2 x kRows x nx heights (2 x 16 x nx; double, nx = 161: 41 KiB), allocated per
+// window (per dense pass) and not cleared (zeroing it cost more than the sliding saved). Costs: over a run of adjacent
+// visited rows, each row is read once and written back once (O(its columns)): over the union of the spans of the (at
 // most three) visited rows whose window held it; every kRows - 2 slides the two kept rows are
 // copied (O(their columns)); load / extend O(columns they add), z / put O(1). (The window it
 // replaces read and wrote back all three rows per visited row: three reads and three
@@ -46,7 +46,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstring>
-#include <vector>
+#include <memory>
 
 #include "grid/rounding_carry.hpp"
 
@@ -61,7 +61,11 @@ class RowWindow {
   static_assert(kRows >= 4);
 
   RowWindow(Store& store, std::size_t nx, std::size_t ny)
-      : store_(store), nx_(nx), ny_(ny), z_(kRows * nx), before_(kRows * nx) {}
+      : store_(store),
+        nx_(nx),
+        ny_(ny),
+        z_(std::make_unique_for_overwrite<Real[]>(kRows * nx)),
+        before_(std::make_unique_for_overwrite<Real[]>(kRows * nx)) {}
 
   // Row iy with columns x0..x1 of the rows iy - 1 .. iy + 1 that exist: slides the window
   // when iy is next to the row loaded last, else writes everything back and starts again.
@@ -109,8 +113,8 @@ class RowWindow {
   Real* row_before(std::size_t r) { return win_before_ + r * nx_; }
   void set_base(std::size_t base) {
     base_ = base;
-    win_ = z_.data() + base * nx_;
-    win_before_ = before_.data() + base * nx_;
+    win_ = z_.get() + base * nx_;
+    win_before_ = before_.get() + base * nx_;
   }
 
   void start(std::size_t iy) {
@@ -154,8 +158,8 @@ class RowWindow {
       if (c.empty()) continue;
       const std::size_t from = (base_ + first + i) * nx_ + c.lo, at = (to + i) * nx_ + c.lo;
       const std::size_t bytes = (c.hi - c.lo + 1) * sizeof(Real);
-      std::memcpy(z_.data() + at, z_.data() + from, bytes);
-      std::memcpy(before_.data() + at, before_.data() + from, bytes);
+      std::memcpy(z_.get() + at, z_.get() + from, bytes);
+      std::memcpy(before_.get() + at, before_.get() + from, bytes);
     }
   }
   // Window row r holds at least columns x0..x1 (a row outside the grid holds none).
@@ -183,15 +187,18 @@ class RowWindow {
 
   Store& store_;
   std::size_t nx_, ny_;
-  std::vector<Real> z_, before_;  // kRows rows of nx: the window's rows; as read from the store
-  std::size_t base_ = 0;          // buffer row of window row 0
-  Real* win_ = nullptr;           // z_ at base_ (data())
-  Real* win_before_ = nullptr;    // before_ at base_
-  bool held_ = false;             // rows are held (loaded since the last flush)
-  bool up_ = true;                // the last slide went up
-  std::size_t iy_ = 0;            // the row loaded last: window rows iy_ - 1 .. iy_ + 1
-  std::size_t lo_ = 1, hi_ = 0;   // columns every held row of the window covers
-  Columns cols_[3];               // loaded columns of each window row
+  // kRows rows of nx: the window's rows; as read from the store. Not initialised: only loaded
+  // columns are ever read (by the window, and by the kernel, whose vector loads at a span's end
+  // are masked).
+  std::unique_ptr<Real[]> z_, before_;
+  std::size_t base_ = 0;         // buffer row of window row 0
+  Real* win_ = nullptr;          // z_ at base_ (data())
+  Real* win_before_ = nullptr;   // before_ at base_
+  bool held_ = false;            // rows are held (loaded since the last flush)
+  bool up_ = true;               // the last slide went up
+  std::size_t iy_ = 0;           // the row loaded last: window rows iy_ - 1 .. iy_ + 1
+  std::size_t lo_ = 1, hi_ = 0;  // columns every held row of the window covers
+  Columns cols_[3];              // loaded columns of each window row
 };
 
 }  // namespace sb::grid
