@@ -682,7 +682,6 @@ inline void dense_pass_rows(Store& store, Active& active, const typename Active:
       row_hi = std::max(row_hi, a + 3 * static_cast<std::size_t>(31 - std::countl_zero(b)));
     };
     const auto visit = [&](std::size_t ix) __attribute__((flatten)) {  // the store's reads and writes inlined
-      if constexpr (kWindowed) window.extend(ix > 0 ? ix - 1 : 0, std::min(ix + 1, nx - 1));  // the span grew
       const VisitResult v =
           erosion_visit<N, Gradient>(rs, t, row_k + ix, ix < 2 || ix + 2 >= nx ? t.of(ix, iy) : middle);
       ++covered;
@@ -744,10 +743,19 @@ inline void dense_pass_rows(Store& store, Active& active, const typename Active:
       }
     }
     // Past the span's end while the node at the end transferred (its block reaches one node further).
+    // (A window holds columns x0 - 1 .. x1 + 1 from its load: only these visits reach beyond.)
     if (x_up) {
-      while (x1 + 1 < nx && bit_at(moved_row, x1)) visit(++x1);
+      while (x1 + 1 < nx && bit_at(moved_row, x1)) {
+        ++x1;
+        if constexpr (kWindowed) window.extend(x1, std::min(x1 + 1, nx - 1));
+        visit(x1);
+      }
     } else {
-      while (x0 > 0 && bit_at(moved_row, x0)) visit(--x0);
+      while (x0 > 0 && bit_at(moved_row, x0)) {
+        --x0;
+        if constexpr (kWindowed) window.extend(x0 > 0 ? x0 - 1 : 0, x0);
+        visit(x0);
+      }
     }
     report.updates += x1 - x0 + 1;
     col_lo = std::min(col_lo, x0), col_hi = std::max(col_hi, x1);
