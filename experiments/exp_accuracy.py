@@ -153,7 +153,8 @@ def run(ctx):
                      rs[0].get("reference.max_error_m", ""), "" if angle == float("-inf") else angle,
                      rs[0].get("pile.roundness", ""), max((r["volume_drift_rel"] for r in rs), key=abs),
                      max(r["max_slope_excess_deg"] for r in rs), max(r["memory_bytes"] for r in rs),
-                     f"{sum(bool(r['settled']) for r in rs)}/{len(rs)}"])
+                     # (the crater is one stamp without erosion: nothing to settle)
+                     "no erosion" if case == "crater" else f"{sum(bool(r['settled']) for r in rs)}/{len(rs)}"])
     md = ctx.table("accuracy", ["case", "model", "rule", "azimuths", "step ms p50", "error", "max error m",
                                 "angle deg", "roundness", "drift rel", "slope excess deg", "bytes", "runs settled"],
                    rows)

@@ -75,61 +75,33 @@
 // See README, "The three back-ends at a glance".
 #include <functional>
 #include <memory>
-#include <optional>
 
 #include "common/height_field.hpp"
 #include "common/scene.hpp"
 #include "common/terrain.hpp"
 #include "grid/active_set.hpp"
-#include "grid/erosion_kernel.hpp"
+#include "grid/grid_terrain_base.hpp"
 #include "grid/height_grid.hpp"
-#include "grid/multires_settle.hpp"
-#include "grid/stencil.hpp"
 
 namespace sb::grid {
 
+// The operations both grids share are GridTerrainBase's (grid_terrain_base.hpp); this class
+// adds the dense storage's name, check() and row-by-row stream_mesh().
 template <class Real>
-class GridTerrain final : public Terrain {
+class GridTerrain final : public GridTerrainBase<HeightGrid<Real>, ActiveSet> {
  public:
   // neighbours: 4 or 8; idle_passes: idle visits before a node leaves the active set.
   GridTerrain(const GridLayout& layout, const std::function<double(const Vec2&)>& initial, int neighbours,
-              int idle_passes);
+              int idle_passes)
+      : GridTerrainBase<HeightGrid<Real>, ActiveSet>(layout, initial, neighbours, idle_passes) {}
 
   std::string_view name() const override { return "grid"; }
-  double height(const Vec2& p) const override { return grid_.height(p); }
-  StampReport stamp(const ToolStamp& s) override;
-  ErosionReport erode(const ErosionRule& rule, const ErosionBudget& budget) override;
-  // Nothing to simplify on a grid: the volume does not change.
-  SimplifyReport simplify(const SimplifyParams&) override { return {.volume_change_m3 = 0.0}; }
-  double volume() const override { return grid_.volume(); }
-  ModelStats stats() const override;
-  SurfaceMesh mesh() const override;
   void stream_mesh(MeshSink& sink) const override;  // O(n) time, O(nx) memory
-  void sample(Raster& out) const override;
   IntegrityReport check() const override;
-  double max_slope_deg() const override;
-
-  // For tests and benchmarks: every node a member of the active set; which sweep erosion
-  // runs (default Auto: the dense pass when the members fill an eighth of their row spans).
-  void activate_all() { active_.activate_all(); }
-  void set_sweep_path(SweepPath path) { sweep_path_ = path; }
-  // Whether large settling budgets start with the multi-resolution cascade (default on;
-  // multires_settle.hpp).
-  void set_multires(bool on) { multires_ = on; }
-  const GridLayout& layout() const { return grid_.layout(); }
-  const HeightGrid<Real>& heights() const { return grid_; }
-  const ActiveSet& active_set() const { return active_; }
-  const Stencil& stencil() const { return stencil_; }
-
- private:
-  HeightGrid<Real> grid_;
-  Stencil stencil_;
-  ActiveSet active_;
-  SweepPath sweep_path_ = SweepPath::Auto;
-  bool multires_ = true;
-  std::optional<ErosionTables> tables_;  // built on the first erode, rebuilt when the rule changes
 };
 
+extern template class GridTerrainBase<HeightGrid<float>, ActiveSet>;
+extern template class GridTerrainBase<HeightGrid<double>, ActiveSet>;
 extern template class GridTerrain<float>;
 extern template class GridTerrain<double>;
 

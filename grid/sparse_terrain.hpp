@@ -32,59 +32,34 @@
 // to compile, 0.85 GB).
 #include <functional>
 #include <memory>
-#include <optional>
 
 #include "common/height_field.hpp"
 #include "common/scene.hpp"
 #include "common/terrain.hpp"
-#include "grid/erosion_kernel.hpp"
-#include "grid/multires_settle.hpp"
+#include "grid/grid_terrain_base.hpp"
 #include "grid/sparse_heights.hpp"
 #include "grid/sparse_idle_counts.hpp"
-#include "grid/stencil.hpp"
 
 namespace sb::grid {
 
+// The operations both grids share are GridTerrainBase's (grid_terrain_base.hpp); this class
+// adds the sparse storage's name, check() and the pruning after settling.
 template <class Real>
-class SparseGridTerrain final : public Terrain {
+class SparseGridTerrain final : public GridTerrainBase<SparseHeights<Real>, SparseActiveSet> {
  public:
   // neighbours: 4 or 8; idle_passes: idle visits before a node leaves the active set.
   SparseGridTerrain(const GridLayout& layout, const std::function<double(const Vec2&)>& initial, int neighbours,
-                    int idle_passes);
+                    int idle_passes)
+      : GridTerrainBase<SparseHeights<Real>, SparseActiveSet>(layout, initial, neighbours, idle_passes) {}
 
   std::string_view name() const override { return "sparse"; }
-  double height(const Vec2& p) const override { return heights_.height(p); }
-  StampReport stamp(const ToolStamp& s) override;
+  // The shared erosion, then, once settled, uniform blocks back to tiles.
   ErosionReport erode(const ErosionRule& rule, const ErosionBudget& budget) override;
-  // Nothing to simplify on a grid: the volume does not change.
-  SimplifyReport simplify(const SimplifyParams&) override { return {.volume_change_m3 = 0.0}; }
-  double volume() const override { return heights_.volume(); }
-  ModelStats stats() const override;
-  SurfaceMesh mesh() const override;
-  void sample(Raster& out) const override;
   IntegrityReport check() const override;
-  double max_slope_deg() const override;
-
-  // For tests and benchmarks: every node a member of the active set; which sweep erosion
-  // runs (default Auto: the dense pass when the members fill an eighth of their row spans).
-  void activate_all() { active_.activate_all(); }
-  void set_sweep_path(SweepPath path) { sweep_path_ = path; }
-  // Whether large settling budgets start with the multi-resolution cascade (default on;
-  // multires_settle.hpp).
-  void set_multires(bool on) { multires_ = on; }
-  const GridLayout& layout() const { return heights_.layout(); }
-  const SparseHeights<Real>& heights() const { return heights_; }
-  const SparseActiveSet& active_set() const { return active_; }
-
- private:
-  SparseHeights<Real> heights_;
-  Stencil stencil_;
-  SparseActiveSet active_;
-  SweepPath sweep_path_ = SweepPath::Auto;
-  bool multires_ = true;
-  std::optional<ErosionTables> tables_;  // built on the first erode, rebuilt when the rule changes
 };
 
+extern template class GridTerrainBase<SparseHeights<float>, SparseActiveSet>;
+extern template class GridTerrainBase<SparseHeights<double>, SparseActiveSet>;
 extern template class SparseGridTerrain<float>;
 extern template class SparseGridTerrain<double>;
 

@@ -80,7 +80,7 @@ void TinTerrain::insert_corners(const std::function<double(const Vec2&)>& z) {
     if (!std::isfinite(h)) throw InputError("terrain: the initial height is not finite at a domain corner");
     const VertexHandle v = cdt_.insert(Point(c.x(), c.y(), h));
     v->info() = VertexInfo{};
-    hint_ = v;
+    edit_walk_.hint = v;
   }
 }
 
@@ -94,7 +94,7 @@ void TinTerrain::finish_build() {
     v->info().border = on_border(xy(v->point())) ? 1 : 0;
     hull_vertices_ += v->info().border;
   }
-  hint_ = cdt_.finite_vertices_begin();
+  edit_walk_.hint = query_walk_.hint = cdt_.finite_vertices_begin();
 }
 
 namespace {

@@ -87,7 +87,7 @@ VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* insert
     return a;
   }
   double change = 0.0;
-  const VertexHandle v = insert_point(m, height(m), inserted, &change);
+  const VertexHandle v = insert_point(m, surface_height(m), inserted, &change);
   if (!*inserted) return v;
   // The split itself keeps the surface; the Delaunay flips after it may not: their volume
   // change (measured over the faces the insertion replaced) is given back to the new vertex

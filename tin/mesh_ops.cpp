@@ -9,8 +9,8 @@
 
 namespace sb::tin::detail {
 
-FaceHandle TinTerrain::start_face() const {
-  FaceHandle f = hint_ != VertexHandle() ? hint_->face() : FaceHandle(cdt_.finite_faces_begin());
+FaceHandle TinTerrain::start_face(const Walk& walk) const {
+  FaceHandle f = walk.hint != VertexHandle() ? walk.hint->face() : FaceHandle(cdt_.finite_faces_begin());
   if (cdt_.is_infinite(f)) f = f->neighbor(f->index(cdt_.infinite_vertex()));
   return f;
 }
@@ -18,10 +18,10 @@ FaceHandle TinTerrain::start_face() const {
 // A remembering stochastic visibility walk (Devillers, Pion, Teillaud 2002) from the hint:
 // cross an edge that separates the face from p, trying the edges in a random order and never
 // straight back. O(1) steps when the hint is near p, which is how the model is queried.
-Location TinTerrain::locate(const Vec2& p) const {
+Location TinTerrain::locate(const Vec2& p, Walk& walk) const {
   const Point q(p.x(), p.y(), 0.0);
   const auto orient = cdt_.geom_traits().orientation_2_object();
-  FaceHandle f = start_face();
+  FaceHandle f = start_face(walk);
   FaceHandle came_from;
   // A walk can only cycle in a non-Delaunay triangulation, and the random order breaks such
   // cycles with probability 1; the cap is a guard, never expected to be reached. The data
@@ -32,8 +32,8 @@ Location TinTerrain::locate(const Vec2& p) const {
   bool walked_out = false;
   for (;;) {
     ++steps;
-    rng_ = rng_ * 1664525u + 1013904223u;
-    const int first = static_cast<int>((rng_ >> 16) % 3);
+    walk.rng = walk.rng * 1664525u + 1013904223u;
+    const int first = static_cast<int>((walk.rng >> 16) % 3);
     FaceHandle next;
     for (int k = 0; k < 3; ++k) {
       const int i = (first + k) % 3;
@@ -110,11 +110,13 @@ bool TinTerrain::on_border(const Vec2& p) const {
   return p.x() == box_.lo.x() || p.x() == box_.hi.x() || p.y() == box_.lo.y() || p.y() == box_.hi.y();
 }
 
-double TinTerrain::height(const Vec2& p) const {
+double TinTerrain::height(const Vec2& p) const { return height_by(p, query_walk_); }
+
+double TinTerrain::height_by(const Vec2& p, Walk& walk) const {
   if (!std::isfinite(p.x()) || !std::isfinite(p.y())) throw InputError("tin: height query at a non-finite point");
   const Vec2 q = clamp_to_domain(p);
-  const Location loc = locate(q);
-  hint_ = loc.face->vertex(0);
+  const Location loc = locate(q, walk);
+  walk.hint = loc.face->vertex(0);
   if (loc.type == Cdt::VERTEX) return loc.face->vertex(loc.index)->point().z();
   return interpolate(loc.face, q);
 }
@@ -168,8 +170,8 @@ VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted
 
   const Location loc = locate(p);
   if (loc.type == Cdt::VERTEX) {
-    hint_ = loc.face->vertex(loc.index);
-    return hint_;
+    edit_walk_.hint = loc.face->vertex(loc.index);
+    return edit_walk_.hint;
   }
   if (snap > 0.0) {
     VertexHandle nearest;
@@ -187,7 +189,7 @@ VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted
       consider(loc.face->neighbor(i)->vertex(cdt_.mirror_index(loc.face, i)));
     }
     if (nearest != VertexHandle()) {
-      hint_ = nearest;
+      edit_walk_.hint = nearest;
       return nearest;
     }
   }
@@ -236,7 +238,7 @@ VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted
     generations_[EdgeKey(e1, v)] = generation;
     generations_[EdgeKey(v, e2)] = generation;
   }
-  hint_ = v;
+  edit_walk_.hint = v;
   if (inserted) *inserted = true;
   return v;
 }
@@ -244,12 +246,13 @@ VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted
 void TinTerrain::remove_vertex(VertexHandle v) {
   drop_from_erosion(v);
   drop_from_simplify(v);
-  if (hint_ == v) {
-    hint_ = VertexHandle();
+  for (Walk* walk : {&edit_walk_, &query_walk_}) {
+    if (walk->hint != v) continue;
+    walk->hint = VertexHandle();
     auto c = cdt_.incident_vertices(v), done = c;
     do {
       if (!cdt_.is_infinite(c)) {
-        hint_ = c;
+        walk->hint = c;
         break;
       }
     } while (++c != done);

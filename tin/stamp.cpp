@@ -272,7 +272,7 @@ void TinTerrain::contour_points(StampWork& w) const {
   auto refine = [&](auto&& self, const Vec2& a, double za, const Vec2& b, double zb, int depth) -> void {
     const Vec2 m = 0.5 * (a + b);
     if (depth >= 8 || (b - a).norm() < shortest) return;
-    const double zm = height(m);
+    const double zm = surface_height(m);
     if (std::abs(zm - 0.5 * (za + zb)) <= tol) return;
     self(self, a, za, m, zm, depth + 1);
     w.o_pts.push_back({m, zm});
@@ -281,7 +281,7 @@ void TinTerrain::contour_points(StampWork& w) const {
   const std::size_t n = w.outer_clip.size();
   for (std::size_t i = 0; i < n; ++i) {
     const Vec2 a = w.outer_clip[i], b = w.outer_clip[(i + 1) % n];
-    const double za = height(a);
+    const double za = surface_height(a);
     w.o_pts.push_back({a, za});
     if (on_same_box_side(a, b, box_)) continue;
     const int pieces =
@@ -290,7 +290,7 @@ void TinTerrain::contour_points(StampWork& w) const {
     double zpa = za;
     for (int k = 1; k <= pieces; ++k) {
       const Vec2 pb = k == pieces ? b : Vec2(a + (b - a) * (static_cast<double>(k) / pieces));
-      const double zpb = height(pb);
+      const double zpb = surface_height(pb);
       refine(refine, pa, zpa, pb, zpb, 0);
       if (k < pieces) w.o_pts.push_back({pb, zpb});
       pa = pb;
@@ -304,12 +304,12 @@ void TinTerrain::contour_points(StampWork& w) const {
   const std::size_t ni = w.inner_clip.size();
   for (std::size_t i = 0; i < ni; ++i) {
     const Vec2 a = w.inner_clip[i], b = w.inner_clip[(i + 1) % ni];
-    w.i_pts.push_back({a, height(a)});
+    w.i_pts.push_back({a, surface_height(a)});
     if (on_same_box_side(a, b, box_)) continue;
     const int pieces = long_edge_pieces(a, b);
     for (int k = 1; k < pieces; ++k) {
       const Vec2 p = a + (b - a) * (static_cast<double>(k) / pieces);
-      w.i_pts.push_back({p, height(p)});
+      w.i_pts.push_back({p, surface_height(p)});
     }
   }
   if (s.profile == BottomProfile::SphereCap && !w.inner_clip.empty()) {
@@ -317,10 +317,11 @@ void TinTerrain::contour_points(StampWork& w) const {
       for (const Vec2& f : footprint) {
         const Vec2 p = s.pose.xy + t * (f - s.pose.xy);
         if (box_.contains(p) && s.contains(p) && distance_to_boundary(footprint, p) > w.gap)
-          w.interior_pts.push_back({p, height(p)});
+          w.interior_pts.push_back({p, surface_height(p)});
       }
     }
-    if (box_.contains(s.pose.xy) && s.contains(s.pose.xy)) w.interior_pts.push_back({s.pose.xy, height(s.pose.xy)});
+    if (box_.contains(s.pose.xy) && s.contains(s.pose.xy))
+      w.interior_pts.push_back({s.pose.xy, surface_height(s.pose.xy)});
   }
 
   // Rim vertices where the band has none nearby: a ring in the band's middle to take the
@@ -572,7 +573,7 @@ StampReport TinTerrain::pour(const ToolStamp& s) {
     Vec2 p;
     double z;
   };
-  std::vector<Pending> pending{{centre, height(centre)}};
+  std::vector<Pending> pending{{centre, surface_height(centre)}};
   constexpr int kRing = 12;
   for (int k = 0; k < kRing; ++k) {
     const double t = 2.0 * std::numbers::pi * k / kRing;

@@ -1,5 +1,5 @@
-// Whole-model queries: volume, statistics and memory, mesh export, raster sampling, slopes,
-// and the integrity check. Each is O(n) except stats() (O(number of container blocks)).
+// Whole-model queries: volume, statistics and memory, mesh export, slopes, and the integrity
+// check (raster sampling: sample.cpp). Each is O(n) except stats() (O(number of container blocks)).
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -86,17 +86,6 @@ SurfaceMesh TinTerrain::mesh() const {
         {index.at(&*e->first->vertex(Cdt::ccw(e->second))), index.at(&*e->first->vertex(Cdt::cw(e->second)))});
   }
   return m;
-}
-
-void TinTerrain::sample(Raster& out) const {
-  out.values.assign(out.nx * out.ny, 0.0);
-  // Boustrophedon order keeps every walk one or two faces long.
-  for (std::size_t iy = 0; iy < out.ny; ++iy) {
-    for (std::size_t k = 0; k < out.nx; ++k) {
-      const std::size_t ix = iy % 2 == 0 ? k : out.nx - 1 - k;
-      out.at(ix, iy) = height(out.point(ix, iy));
-    }
-  }
 }
 
 double TinTerrain::max_slope_deg() const {

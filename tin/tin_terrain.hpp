@@ -42,7 +42,10 @@
 //                     10^3 to 10^6, on tin.initial_points TINs with their border points too,
 //                     log-log slope -0.006 (tests/bench/tin_step_bench.cpp; 0.73 ms on the
 //                     heightmap scene's TIN), where the paper measured O(n^1.5)
-//   volume, mesh, check, max_slope_deg: O(n); sample: O(raster points), walking row by row
+//   volume, mesh, check, max_slope_deg: O(n); sample: O(faces + raster points), rasterising the
+//                     faces (~225 instructions a point), or a short walk per point (~1000) where
+//                     the raster has fewer than a quarter as many points as the TIN has faces
+//                     (tin/sample.cpp)
 // Volume: stamps, erosion and simplification conserve volume except where the Delaunay
 // triangulation changes under a non-planar surface (flips after insertions and edge splits,
 // removals of not quite planar vertices, dropped constraints). tin.conserve_volume (the
@@ -59,7 +62,8 @@
 // read the receiver's height (one ring there, measured: 7 % fewer visits on trench.toml, but the pile's flank settles
 // 0.7 degrees further from critical); tan_settle is its settling criterion. A stamp re-activates the vertices whose
 // heights it changed with their neighbours, and of the rest of the retriangulated region only vertices next to a face
-// steeper than critical. Not thread-safe: height() and sample() move the walk hint.
+// steeper than critical. Not thread-safe: height() and sample() move their walk hint (a walk of their own: what an
+// edit builds never depends on the queries made before it, tests/unit/tin_reproducible_test.cpp).
 #include <memory>
 #include <vector>
 

@@ -7,31 +7,26 @@
 #include <cstdio>
 #include <numbers>
 #include <random>
+#include <string>
 
 #include "common/height_field.hpp"
 #include "common/scene.hpp"
 #include "common/schedule.hpp"
+#include "tests/unit/terrain_test_support.hpp"
 #include "tin/tin_terrain.hpp"
 
 namespace sb::tin::stress {
 namespace {
 
-const char* kScene = R"(
-[domain]
-size_m = [0.3, 0.3]
-[terrain]
-kind = "flat"
-height_m = 0.1
-[tool]
-shape = "disk"
-radius_m = 0.02
-depth_m = 0.01
+// 0.3 m of flat sand 0.1 m deep (the default 30-degree critical angle), a 2 cm disk cutting
+// 1 cm deep along the diagonal.
+const std::string kScene = test::flat_sand_scene("0.3", "0.1", test::kDisk2cm, R"(
 [stroke]
 path_m = [[0.05, 0.05], [0.25, 0.25]]
 spacing_m = 0.005
-)";
+)");
 
-const char* kDunes = R"(
+const std::string kDunes = R"(
 [domain]
 size_m = [0.3, 0.3]
 [terrain]
@@ -59,9 +54,7 @@ struct Runner {
   std::uint32_t generation = 0;
 
   explicit Runner(const Scene& s)
-      : scene(s),
-        terrain(make_tin_terrain(s, HeightField::from_scene(s))),
-        rule(ErosionRule::from(s.material, s.erosion.settle_tolerance_deg, s.erosion.rule)) {}
+      : scene(s), terrain(make_tin_terrain(s, HeightField::from_scene(s))), rule(test::rule_of(s)) {}
 
   // One step with check() after each phase; returns false (after reporting) on a problem.
   bool step(ToolStamp st) {
@@ -94,7 +87,7 @@ struct Runner {
 };
 
 TEST(TinStress, CrossingStrokes) {
-  for (const char* text : {kScene, kDunes}) {
+  for (const std::string& text : {kScene, kDunes}) {
     for (bool conserve : {false, true}) {
       Runner run(parse_scene(text, "stress", {std::string("tin.conserve_volume=") + (conserve ? "true" : "false")}));
       const double v0 = run.terrain->volume();
@@ -126,7 +119,7 @@ TEST(TinStress, CrossingStrokes) {
 // Curvature refinement (tin.curvature_tolerance_m) splits constrained and unconstrained
 // creases between stamps: the mesh stays valid after every phase and the volume exact.
 TEST(TinStress, CrossingStrokesWithCurvatureRefinement) {
-  for (const char* text : {kScene, kDunes}) {
+  for (const std::string& text : {kScene, kDunes}) {
     Runner run(parse_scene(text, "stress", {"tin.conserve_volume=true", "tin.curvature_tolerance_m=0.0003"}));
     Runner plain(parse_scene(text, "stress", {"tin.conserve_volume=true"}));
     const double v0 = run.terrain->volume();
@@ -147,7 +140,7 @@ TEST(TinStress, CrossingStrokesWithCurvatureRefinement) {
 
 // Strokes that each settle to rest, with check() and the volume after every step; returns
 // the vertices removed and the steepest edge after each rest.
-std::pair<std::size_t, std::vector<double>> strokes_to_rest(const char* text, bool coarsen) {
+std::pair<std::size_t, std::vector<double>> strokes_to_rest(const std::string& text, bool coarsen) {
   Runner run(parse_scene(text, "stress", {std::string("tin.coarsen=") + (coarsen ? "true" : "false")}));
   const double v0 = run.terrain->volume();
   std::size_t removed = 0;
@@ -179,7 +172,7 @@ std::pair<std::size_t, std::vector<double>> strokes_to_rest(const char* text, bo
 }
 
 TEST(TinStress, CoarseningAtRestKeepsVolumeSlopeAndIntegrity) {
-  for (const char* text : {kScene, kDunes}) {
+  for (const std::string& text : {kScene, kDunes}) {
     const Scene scene = parse_scene(text, "stress");
     const double stable = scene.material.critical_angle_deg + scene.erosion.settle_tolerance_deg + 1e-6;
     const auto [kept, plain] = strokes_to_rest(text, false);

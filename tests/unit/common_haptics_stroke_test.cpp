@@ -16,6 +16,7 @@
 #include "common/metrics.hpp"
 #include "harness/run/backends.hpp"
 #include "harness/run/runner.hpp"
+#include "terrain_test_support.hpp"
 
 namespace sb::haptics {
 namespace {
@@ -53,7 +54,7 @@ StrokeRun replay_stroke(const PreparedScene& prepared, const Trajectory& stroke,
     patch_centre = centre;
   };
   republish(patch_centre);
-  const ErosionRule rule = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg, scene.erosion.rule);
+  const ErosionRule rule = sb::test::rule_of(scene);
   ServoCore core(device, patches, 40.0, rendering, kDt);
   core.start();
 

@@ -12,15 +12,7 @@ class GridErosion : public ::testing::Test {};
 TYPED_TEST_SUITE(GridErosion, StorageTypes, StorageName);
 
 // A column of sand poured onto flat ground, 0.24 m tall and 4 cm wide.
-ToolStamp column() {
-  ToolSpec spec;
-  spec.shape = ToolShape::Pour;
-  spec.radius_m = 0.0201;
-  spec.pour_volume_m3 = 3e-4;
-  ToolPose pose;
-  pose.xy = {0.25, 0.25};
-  return make_stamp(spec, pose, Vec2::Zero(), 0);
-}
+ToolStamp column() { return sb::test::pour_at({0.25, 0.25}, 0.0201, 3e-4); }
 
 TYPED_TEST(GridErosion, FullRelaxationEndsAtTheCriticalAngle) {
   for (const int neighbours : {8, 4}) {

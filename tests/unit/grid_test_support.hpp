@@ -13,27 +13,20 @@
 #include "common/scene.hpp"
 #include "common/schedule.hpp"
 #include "grid/grid_terrain.hpp"
+#include "terrain_test_support.hpp"
 
 namespace sb::grid::test {
 
 // A 0.5 m square of flat sand 0.1 m deep on a 5 mm grid (101 x 101 nodes) and a stroke
 // along x through the middle; the tool section comes separately (keys differ per shape).
 inline std::string flat_scene(const std::string& tool) {
-  return R"(
-[domain]
-size_m = [0.5, 0.5]
-[terrain]
-kind = "flat"
-height_m = 0.1
-[material]
-critical_angle_deg = 30.0
+  return sb::test::flat_sand_scene("0.5", "0.1", tool, R"(
 [stroke]
 path_m = [[0.1, 0.25], [0.4, 0.25]]
 spacing_m = 0.005
 [grid]
 cell_m = 0.005
-[tool]
-)" + tool;
+)");
 }
 // A 3 cm disk cutting 1 cm deep.
 inline const char* kDisk = "shape = \"disk\"\nradius_m = 0.03\ndepth_m = 0.01\n";
@@ -54,23 +47,9 @@ std::unique_ptr<GridTerrain<Real>> make_grid(const Scene& s) {
   return make_grid<Real>(s, [&field](const Vec2& p) { return field(p); });
 }
 
-inline ErosionRule rule_of(const Scene& s) {
-  return ErosionRule::from(s.material, s.erosion.settle_tolerance_deg, s.erosion.rule);
-}
-
-inline StampSchedule schedule_of(const Scene& s) {
-  const HeightField field = HeightField::from_scene(s);
-  return make_schedule(s.tool, s.stroke, [field](const Vec2& p) { return field(p); });
-}
-
-// A stamp of the scene's tool at one pose.
-inline ToolStamp stamp_at(const Scene& s, Vec2 xy, double bottom_z, Vec2 motion = {1.0, 0.0}) {
-  ToolPose pose;
-  pose.xy = xy;
-  pose.bottom_z = bottom_z;
-  pose.heading_rad = std::atan2(motion.y(), motion.x());
-  return make_stamp(s.tool, pose, motion, 0);
-}
+using sb::test::rule_of;
+using sb::test::schedule_of;
+using sb::test::stamp_at;
 
 // The flat scene's sand height as the storage type holds it.
 template <class Real>
@@ -84,12 +63,6 @@ template <class Real>
 bool same_bits(Real a, Real b) {
   return std::memcmp(&a, &b, sizeof(Real)) == 0;
 }
-
-#define SB_EXPECT_CHECK_OK(terrain)                                                \
-  do {                                                                             \
-    const ::sb::IntegrityReport integrity_ = (terrain).check();                    \
-    EXPECT_TRUE(integrity_.ok()) << ::testing::PrintToString(integrity_.problems); \
-  } while (0)
 
 using StorageTypes = ::testing::Types<float, double>;
 struct StorageName {

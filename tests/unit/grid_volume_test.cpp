@@ -9,18 +9,7 @@ namespace {
 
 // A zig-zag stroke over flat sand on the paper's domain (diagonal 1 m): 1001 stamps of a
 // 2 cm disk cutting 1 cm deep, erosion of 4 passes after each.
-const char* kStrokeScene = R"(
-[domain]
-size_m = [0.7071, 0.7071]
-[terrain]
-kind = "flat"
-height_m = 0.1
-[material]
-critical_angle_deg = 30.0
-[tool]
-shape = "disk"
-radius_m = 0.02
-depth_m = 0.01
+const std::string kStrokeScene = sb::test::flat_sand_scene("0.7071", "0.1", sb::test::kDisk2cm, R"(
 [stroke]
 path_m = [[0.1, 0.1], [0.6, 0.1], [0.6, 0.35], [0.1, 0.35], [0.1, 0.6], [0.6, 0.6]]
 spacing_m = 0.002
@@ -28,7 +17,7 @@ spacing_m = 0.002
 max_passes_per_step = 4
 [grid]
 cell_m = 0.005
-)";
+)");
 
 struct Drift {
   double relative = 0.0;
@@ -96,13 +85,7 @@ TYPED_TEST(GridVolumeTracking, ReportedChangesMatchTheIntegral) {
   const ErosionRule rule = rule_of(s);
   const double v0 = t->volume();
   double tracked = v0;
-  ToolSpec pour;
-  pour.shape = ToolShape::Pour;
-  pour.radius_m = 0.02;
-  pour.pour_volume_m3 = 1e-5;
-  ToolPose at;
-  at.xy = {0.3, 0.3};
-  const StampReport poured = t->stamp(make_stamp(pour, at, Vec2::Zero(), 0));
+  const StampReport poured = t->stamp(sb::test::pour_at({0.3, 0.3}, 0.02, 1e-5));
   ASSERT_FALSE(std::isnan(poured.volume_change_m3));
   EXPECT_NEAR(poured.volume_change_m3, 1e-5, 1e-5 * 1e-7);  // the pour spreads it in the storage type
   tracked += poured.volume_change_m3;

@@ -14,23 +14,17 @@ namespace fs = std::filesystem;
 
 using sb::test::sandbench;  // the binary as a process (harness_test_support.hpp)
 
-std::string scene(const char* name) { return std::string(SB_SOURCE_DIR) + "/experiments/scenes/" + name; }
+using sb::test::shipped_scene;
 
-class Cli : public ::testing::Test {
+class Cli : public sb::test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("sb_cli_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  Cli() : TempDirTest("sb_cli_") {}
   bool dir_is_empty() const { return fs::is_empty(dir_); }
-  fs::path dir_;
 };
 
 TEST_F(Cli, BadSceneValueExitsTwoNamesTheFieldAndWritesNothing) {
   const fs::path out = dir_ / "run.h5";
-  const auto r = sandbench("run " + scene("flat_stroke.toml") + " --backend grid --out " + out.string() +
+  const auto r = sandbench("run " + shipped_scene("flat_stroke.toml") + " --backend grid --out " + out.string() +
                            " --set tool.radius_m=-3");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_NE(r.out.find("tool.radius_m"), std::string::npos) << r.out;
@@ -49,16 +43,18 @@ TEST_F(Cli, UnknownKeyInSceneFileExitsTwo) {
 
 TEST_F(Cli, MissingSceneFileAndBadOptionsExitTwo) {
   EXPECT_EQ(sandbench("run " + (dir_ / "none.toml").string() + " --backend grid").code, 2);
-  EXPECT_EQ(sandbench("run " + scene("flat_stroke.toml") + " --backend voxels").code, 2);
-  EXPECT_EQ(sandbench("run " + scene("flat_stroke.toml")).code, 2);  // --backend is required
+  EXPECT_EQ(sandbench("run " + shipped_scene("flat_stroke.toml") + " --backend voxels").code, 2);
+  EXPECT_EQ(sandbench("run " + shipped_scene("flat_stroke.toml")).code, 2);  // --backend is required
   EXPECT_EQ(sandbench("frobnicate").code, 2);
-  EXPECT_EQ(sandbench("compare " + scene("flat_stroke.toml") + " --backends grid,hex --out " + dir_.string()).code, 2);
+  EXPECT_EQ(
+      sandbench("compare " + shipped_scene("flat_stroke.toml") + " --backends grid,hex --out " + dir_.string()).code,
+      2);
   EXPECT_TRUE(dir_is_empty());
 }
 
 TEST_F(Cli, RunPrintsEveryContractMetricAndWritesTheRunFile) {
   const fs::path out = dir_ / "grid.h5";
-  const auto r = sandbench("run " + scene("flat_stroke.toml") + " --backend grid --json --out " + out.string());
+  const auto r = sandbench("run " + shipped_scene("flat_stroke.toml") + " --backend grid --json --out " + out.string());
   ASSERT_EQ(r.code, 0) << r.out;
   const auto json_start = r.out.find('{');
   const auto json = nlohmann::json::parse(r.out.substr(json_start, r.out.rfind('}') - json_start + 1));

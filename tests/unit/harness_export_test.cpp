@@ -28,17 +28,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
+using test::slurp;
 
-class Export : public ::testing::Test {
+class Export : public test::TempDirTest {
  protected:
+  Export() : TempDirTest("sb_export_") {}
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("sb_export_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+    TempDirTest::SetUp();
     // A small TIN-like mesh: a raster's lattice with two triangles turned clockwise, and
     // constrained edges along one row.
     raster_ = Raster::covering({Vec2(0.1, 0.2), Vec2(0.3, 0.35)}, 0.01);
@@ -52,8 +48,6 @@ class Export : public ::testing::Test {
     std::swap(mesh_.triangles[10][0], mesh_.triangles[10][1]);
     for (std::uint32_t ix = 0; ix + 1 < raster_.nx; ++ix) mesh_.constrained_edges.push_back({ix + 21, ix + 22});
   }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
   Raster raster_;
   SurfaceMesh mesh_;
 };
@@ -241,8 +235,7 @@ using test::sandbench;  // the binary as a process (harness_test_support.hpp)
 
 TEST_F(Export, CommandWritesEachFormatAndRefusesBadInput) {
   const fs::path run = dir_ / "grid.h5";
-  auto r = sandbench("run " + std::string(SB_SOURCE_DIR) +
-                     "/experiments/scenes/flat_stroke.toml --backend grid --out " + run.string());
+  auto r = sandbench("run " + test::shipped_scene("flat_stroke.toml") + " --backend grid --out " + run.string());
   ASSERT_EQ(r.code, 0) << r.out;
   for (const char* format : {"ply", "obj", "png16"}) {
     const fs::path out = dir_ / (std::string("out.") + format);

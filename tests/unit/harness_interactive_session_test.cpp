@@ -32,17 +32,11 @@ nlohmann::json last_json(const std::string& out) {
   return nlohmann::json::parse(out.substr(a, b - a + 1));
 }
 
-std::string scene_path() { return std::string(SB_SOURCE_DIR) + "/experiments/scenes/flat_stroke.toml"; }
+std::string scene_path() { return test::shipped_scene("flat_stroke.toml"); }
 
-class Session_ : public ::testing::Test {
+class Session_ : public sb::test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("sb_session_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
+  Session_() : TempDirTest("sb_session_") {}
 };
 
 Session sample_session() {

@@ -19,26 +19,17 @@
 #include <set>
 
 #include "harness/io/session_file.hpp"
+#include "harness_test_support.hpp"
 
 namespace sb {
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Result {
-  int code = -1;
-  std::string out;
-};
+using Result = test::CliResult;
 
-Result shell(const std::string& cmd) {
-  Result r;
-  FILE* pipe = ::popen(("{ " + cmd + "; } 2>&1").c_str(), "r");
-  std::array<char, 4096> buf{};
-  while (std::fgets(buf.data(), buf.size(), pipe)) r.out += buf.data();
-  const int status = ::pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+// `cmd` in the shell, its stdout and stderr together.
+Result shell(const std::string& cmd) { return test::run_shell("{ " + cmd + "; } 2>&1"); }
 
 bool have_xvfb() { return shell("command -v xvfb-run").code == 0; }
 
@@ -47,7 +38,7 @@ std::string xvfb() {
   return "ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 xvfb-run -a -s '-screen 0 1024x768x24' ";
 }
 
-std::string scene_path() { return std::string(SB_SOURCE_DIR) + "/experiments/scenes/flat_stroke.toml"; }
+std::string scene_path() { return test::shipped_scene("flat_stroke.toml"); }
 
 nlohmann::json read_json(const fs::path& file) {
   std::ifstream in(file);

@@ -28,46 +28,26 @@ namespace fs = std::filesystem;
 using sb::test::CliResult;
 using sb::test::sandbench;
 
-std::string scene(const char* name) { return std::string(SB_SOURCE_DIR) + "/experiments/scenes/" + name; }
+using sb::test::shipped_scene;
+using sb::test::slurp;
 
 // `sh -c SCRIPT`: for environment changes and resource limits. SCRIPT must not hold quotes '.
-CliResult run_sh(const std::string& script) {
-  CliResult r;
-  const std::string cmd = "sh -c '" + script + "' 2>&1";
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  char buf[4096];
-  while (std::fgets(buf, sizeof buf, pipe)) r.out += buf;
-  const int status = ::pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+CliResult run_sh(const std::string& script) { return sb::test::run_shell("sh -c '" + script + "' 2>&1"); }
 
 bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-class Outputs : public ::testing::Test {
+class Outputs : public sb::test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("sb_outputs_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
+  Outputs() : TempDirTest("sb_outputs_") {}
 
   // A grid run of the flat stroke into dir_/NAME.
   fs::path grid_run(const std::string& name = "run.h5", const std::string& extra = "") {
     const fs::path out = dir_ / name;
-    const CliResult r = sandbench("run " + scene("flat_stroke.toml") + " --backend grid --out " + out.string() + extra);
+    const CliResult r =
+        sandbench("run " + shipped_scene("flat_stroke.toml") + " --backend grid --out " + out.string() + extra);
     EXPECT_EQ(r.code, 0) << r.out;
     return out;
   }
-  fs::path dir_;
 };
 
 // --- the command line ---------------------------------------------------------------------
@@ -92,11 +72,11 @@ TEST_F(Outputs, UnknownCommandsHelpAndVersion) {
 }
 
 TEST_F(Outputs, WrongFlagsNameTheCommandAndBackEndsComeFromTheFactory) {
-  CliResult r = sandbench("run " + scene("flat_stroke.toml") + " --backend grid --frobnicate");
+  CliResult r = sandbench("run " + shipped_scene("flat_stroke.toml") + " --backend grid --frobnicate");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_TRUE(contains(r.out, "sandbench run: error")) << r.out;
   EXPECT_TRUE(contains(r.out, "--frobnicate")) << r.out;
-  r = sandbench("run " + scene("flat_stroke.toml") + " --backend voxel --out " + (dir_ / "x.h5").string());
+  r = sandbench("run " + shipped_scene("flat_stroke.toml") + " --backend voxel --out " + (dir_ / "x.h5").string());
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_TRUE(contains(r.out, "--backend: \"voxel\"")) << r.out;  // not --backends
   EXPECT_TRUE(contains(r.out, "tin, grid")) << r.out;
@@ -105,7 +85,7 @@ TEST_F(Outputs, WrongFlagsNameTheCommandAndBackEndsComeFromTheFactory) {
 
 TEST_F(Outputs, InteractiveWithoutADisplaySaysSoWithTheXvfbHint) {
   const CliResult r = run_sh("env -u DISPLAY -u WAYLAND_DISPLAY " + std::string(SB_CLI_PATH) + " interactive " +
-                             scene("flat_stroke.toml") + " --backend grid --frames 1");
+                             shipped_scene("flat_stroke.toml") + " --backend grid --frames 1");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_TRUE(contains(r.out, "xvfb-run")) << r.out;
 }
@@ -114,7 +94,7 @@ TEST_F(Outputs, InteractiveWithoutADisplaySaysSoWithTheXvfbHint) {
 
 TEST_F(Outputs, OutputThatIsTheSceneIsRefusedAndTheSceneSurvives) {
   const fs::path copy = dir_ / "scene.toml";
-  fs::copy_file(scene("flat_stroke.toml"), copy);
+  fs::copy_file(shipped_scene("flat_stroke.toml"), copy);
   const std::string before = slurp(copy);
   const CliResult r = sandbench("run " + copy.string() + " --backend grid --out " + copy.string());
   EXPECT_EQ(r.code, 2) << r.out;
@@ -146,7 +126,7 @@ TEST_F(Outputs, SpecialFilesDirectoriesSymlinksAndEmptyPathsAreRefused) {
   std::ofstream(target) << "keep";
   fs::create_symlink(target, dir_ / "link.h5");
   fs::create_directories(dir_ / "folder");
-  const std::string run = "run " + scene("flat_stroke.toml") + " --backend grid --out ";
+  const std::string run = "run " + shipped_scene("flat_stroke.toml") + " --backend grid --out ";
   for (const std::string& out : {fifo.string(), (dir_ / "link.h5").string(), (dir_ / "folder").string(),
                                  std::string("/dev/null"), std::string("''")}) {
     const CliResult r = sandbench(run + out);
@@ -158,7 +138,8 @@ TEST_F(Outputs, SpecialFilesDirectoriesSymlinksAndEmptyPathsAreRefused) {
   EXPECT_EQ(slurp(target), "keep");
   EXPECT_TRUE(fs::is_character_file("/dev/null"));
   // compare --out must be a directory.
-  const CliResult c = sandbench("compare " + scene("flat_stroke.toml") + " --backends grid --out " + target.string());
+  const CliResult c =
+      sandbench("compare " + shipped_scene("flat_stroke.toml") + " --backends grid --out " + target.string());
   EXPECT_EQ(c.code, 2) << c.out;
   EXPECT_EQ(slurp(target), "keep");
 }
@@ -183,7 +164,7 @@ TEST_F(Outputs, DiskFullIsOneCleanLineAndLeavesNothing) {
       ::geteuid() == 0 &&
       std::system(("mount -t tmpfs -o size=64k tmpfs " + small.string() + " 2>/dev/null").c_str()) == 0;
   const std::string limit = mounted ? "" : "trap \"\" XFSZ; ulimit -f 64; ";
-  const CliResult r = run_sh(limit + std::string(SB_CLI_PATH) + " run " + scene("flat_stroke.toml") +
+  const CliResult r = run_sh(limit + std::string(SB_CLI_PATH) + " run " + shipped_scene("flat_stroke.toml") +
                              " --backend tin --out " + (small / "run.h5").string());
   const bool empty = fs::is_empty(small);
   if (mounted) std::system(("umount " + small.string()).c_str());
@@ -296,7 +277,7 @@ nlohmann::json summary_of(const CliResult& r) {
 }
 
 TEST_F(Outputs, WarningsOnStderrAndInTheSummary) {
-  const std::string base = "run " + scene("flat_stroke.toml") + " --backend grid --json --out ";
+  const std::string base = "run " + shipped_scene("flat_stroke.toml") + " --backend grid --json --out ";
   CliResult r = sandbench(base + (dir_ / "a.h5").string() + " --set 'stroke.path_m=[[5.0, 5.0], [5.1, 5.1]]'");
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_TRUE(contains(r.out, "sandbench: warning")) << r.out;
@@ -318,7 +299,7 @@ TEST_F(Outputs, WarningsOnStderrAndInTheSummary) {
 
 TEST_F(Outputs, HopelesslyLongRunsAreRefusedUpFront) {
   // 2.1e6 stamps of a 4096-gon: refused in the scene check, before any allocation.
-  const CliResult r = sandbench("run " + scene("flat_stroke.toml") + " --backend grid --out " +
+  const CliResult r = sandbench("run " + shipped_scene("flat_stroke.toml") + " --backend grid --out " +
                                 (dir_ / "x.h5").string() + " --set tool.sides=4096 --set stroke.repeat=100000");
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_TRUE(contains(r.out, "stroke.spacing_m")) << r.out;
@@ -329,7 +310,8 @@ TEST_F(Outputs, HopelesslyLongRunsAreRefusedUpFront) {
 // --- --unset, scene-keys ------------------------------------------------------------------
 
 TEST_F(Outputs, UnsetSwitchesTheToolShape) {
-  const std::string base = "run " + scene("flat_stroke.toml") + " --backend grid --out " + (dir_ / "x.h5").string();
+  const std::string base =
+      "run " + shipped_scene("flat_stroke.toml") + " --backend grid --out " + (dir_ / "x.h5").string();
   CliResult r = sandbench(base + " --set tool.shape=box --set 'tool.size_m=[0.04, 0.02]'");
   EXPECT_EQ(r.code, 2) << r.out;  // radius_m and sides are not box keys
   r = sandbench(base +
@@ -367,8 +349,8 @@ sb::Session one_stamp_session(double bottom_z) {
 TEST_F(Outputs, ReplayOutOfRangeIsRefusedAndCompareReplaysOnEveryBackEnd) {
   const fs::path bad = dir_ / "bad.csv";
   sb::write_session(bad, one_stamp_session(-1e300));
-  CliResult r = sandbench("run " + scene("flat_stroke.toml") + " --backend tin --replay " + bad.string() + " --out " +
-                          (dir_ / "x.h5").string());
+  CliResult r = sandbench("run " + shipped_scene("flat_stroke.toml") + " --backend tin --replay " + bad.string() +
+                          " --out " + (dir_ / "x.h5").string());
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_TRUE(contains(r.out, "bottom_z")) << r.out;
 
@@ -376,8 +358,8 @@ TEST_F(Outputs, ReplayOutOfRangeIsRefusedAndCompareReplaysOnEveryBackEnd) {
   huge_pour.tools[0].shape = sb::ToolShape::Pour;
   huge_pour.tools[0].pour_volume_m3 = 1e300;
   sb::write_session(dir_ / "pour.csv", huge_pour);
-  r = sandbench("run " + scene("flat_stroke.toml") + " --backend grid --replay " + (dir_ / "pour.csv").string() +
-                " --out " + (dir_ / "y.h5").string());
+  r = sandbench("run " + shipped_scene("flat_stroke.toml") + " --backend grid --replay " +
+                (dir_ / "pour.csv").string() + " --out " + (dir_ / "y.h5").string());
   EXPECT_EQ(r.code, 2) << r.out;
   EXPECT_TRUE(contains(r.out, "tool.volume_m3")) << r.out;
 
@@ -385,7 +367,7 @@ TEST_F(Outputs, ReplayOutOfRangeIsRefusedAndCompareReplaysOnEveryBackEnd) {
   sb::Session tiny = one_stamp_session(0.09);
   tiny.stamps[0].motion_dir = sb::Vec2(1.0, 5e-324);
   sb::write_session(dir_ / "good.csv", tiny);
-  r = sandbench("compare " + scene("flat_stroke.toml") + " --backends tin,grid --replay " +
+  r = sandbench("compare " + shipped_scene("flat_stroke.toml") + " --backends tin,grid --replay " +
                 (dir_ / "good.csv").string() + " --json --out " + (dir_ / "cmp").string());
   ASSERT_EQ(r.code, 0) << r.out;
   EXPECT_EQ(summary_of(r)["stamps"], 2);
@@ -415,7 +397,7 @@ std::vector<sb::Vec3> ply_vertices(const fs::path& file) {
 
 TEST_F(Outputs, UtmOffsetTinSurvivesPlyExactlyAndTheCrsReachesTheSidecar) {
   const fs::path run = dir_ / "utm.h5";
-  const CliResult r = sandbench("run " + scene("flat_stroke.toml") + " --backend tin --out " + run.string() +
+  const CliResult r = sandbench("run " + shipped_scene("flat_stroke.toml") + " --backend tin --out " + run.string() +
                                 " --set 'domain.origin_m=[500000.0, 5000000.0]'" +
                                 " --set 'stroke.path_m=[[500000.3182, 5000000.3182], [500000.38891, 5000000.38891]]'" +
                                 " --set 'domain.crs=\"EPSG:32633\"'");

@@ -136,12 +136,8 @@ TEST_F(Render, SameInputGivesTheSameBytes) {
   fs::create_directories(dir);
   write_png(dir / "a.png", a);
   write_png(dir / "b.png", b);
-  auto slurp = [](const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-  };
-  EXPECT_EQ(slurp(dir / "a.png"), slurp(dir / "b.png"));
-  EXPECT_GT(slurp(dir / "a.png").size(), 1000u);
+  EXPECT_EQ(test::slurp(dir / "a.png"), test::slurp(dir / "b.png"));
+  EXPECT_GT(test::slurp(dir / "a.png").size(), 1000u);
   fs::remove_all(dir);
 }
 
@@ -302,20 +298,18 @@ std::pair<int, int> png_size(const fs::path& file) {
   return {be(16), be(20)};
 }
 
-class RenderCli : public ::testing::Test {
+class RenderCli : public test::TempDirTest {
  protected:
+  RenderCli() : TempDirTest("sb_render_cli_") {}
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("sb_render_cli_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
+    TempDirTest::SetUp();
     run_ = dir_ / "grid.h5";
-    const auto r = sandbench("run " + std::string(SB_SOURCE_DIR) +
-                             "/experiments/scenes/flat_stroke.toml --backend grid --out " + run_.string());
+    const auto r =
+        sandbench("run " + test::shipped_scene("flat_stroke.toml") + " --backend grid --out " + run_.string());
     ASSERT_EQ(r.code, 0) << r.out;
   }
-  void TearDown() override { fs::remove_all(dir_); }
   std::size_t files() const { return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir_), {})); }
-  fs::path dir_, run_;
+  fs::path run_;
 };
 
 TEST_F(RenderCli, WritesPicturesOfTheRequestedSize) {

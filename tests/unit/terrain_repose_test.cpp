@@ -17,6 +17,7 @@
 #include "common/scene.hpp"
 #include "common/schedule.hpp"
 #include "harness/run/backends.hpp"
+#include "terrain_test_support.hpp"
 
 namespace sb {
 namespace {
@@ -87,8 +88,8 @@ class ReposeTyped : public ::testing::Test {
     Outcome o;
     o.before = measure_plane(before);
     const double v0 = t->volume();
-    const StampSchedule sch = make_schedule(s.tool, s.stroke, [&field](const Vec2& p) { return field(p); });
-    const ErosionRule rule = ErosionRule::from(s.material, s.erosion.settle_tolerance_deg, s.erosion.rule);
+    const StampSchedule sch = test::schedule_of(s);
+    const ErosionRule rule = test::rule_of(s);
     for (const ToolStamp& st : sch.stamps) t->stamp(st);
     for (int passes = 0; passes < 100000 && !o.settled; passes += 256) {
       t->erode(rule, ErosionBudget{256});
@@ -161,8 +162,8 @@ TYPED_TEST(ReposeTyped, SteepConeRelaxesToARoundConeAtCritical) {
   Raster before = Raster::covering(s.domain.box(), s.output.raster_m);
   t->sample(before);
   const double v0 = t->volume();
-  const StampSchedule sch = make_schedule(s.tool, s.stroke, [&field](const Vec2& p) { return field(p); });
-  const ErosionRule rule = ErosionRule::from(s.material, s.erosion.settle_tolerance_deg, s.erosion.rule);
+  const StampSchedule sch = test::schedule_of(s);
+  const ErosionRule rule = test::rule_of(s);
   for (const ToolStamp& st : sch.stamps) t->stamp(st);
   bool settled = false;
   for (int passes = 0; passes < 100000 && !settled; passes += 256) {

@@ -14,6 +14,7 @@
 #include "common/scene.hpp"
 #include "common/schedule.hpp"
 #include "harness/run/backends.hpp"
+#include "terrain_test_support.hpp"
 
 namespace sb {
 namespace {
@@ -36,26 +37,15 @@ struct Sparse {
   static constexpr double kVolumeTolerance = 1e-12;
 };
 
-const char* kFlat = R"(
-[domain]
-size_m = [0.3, 0.3]
-[terrain]
-kind = "flat"
-height_m = 0.1
-[material]
-critical_angle_deg = 30.0
-[tool]
-shape = "disk"
-radius_m = 0.02
-depth_m = 0.01
+const std::string kFlat = test::flat_sand_scene("0.3", "0.1", test::kDisk2cm, R"(
 [stroke]
 path_m = [[0.1, 0.15], [0.2, 0.15]]
 spacing_m = 0.005
 [grid]
 cell_m = 0.004
-)";
+)");
 
-const char* kDunes = R"(
+const std::string kDunes = R"(
 [domain]
 size_m = [0.3, 0.3]
 [terrain]
@@ -79,20 +69,10 @@ tolerance_m = 0.0005
 cell_m = 0.004
 )";
 
-const char* kPile = R"(
-[domain]
-size_m = [0.2, 0.2]
-[terrain]
-kind = "flat"
-height_m = 0.05
-[material]
-critical_angle_deg = 30.0
+const std::string kPile =
+    test::flat_sand_scene("0.2", "0.05", "shape = \"pour\"\nradius_m = 0.006\nvolume_m3 = 2e-6\n", R"(
 [erosion]
 max_passes_per_step = 8
-[tool]
-shape = "pour"
-radius_m = 0.006
-volume_m3 = 2e-6
 [stroke]
 path_m = [[0.1, 0.1]]
 repeat = 4
@@ -100,12 +80,12 @@ repeat = 4
 refine_m = 0.004
 [grid]
 cell_m = 0.004
-)";
+)");
 
 template <class Backend>
 class TerrainTyped : public ::testing::Test {
  protected:
-  Scene scene(const char* text, std::vector<std::string> extra = {}) const {
+  Scene scene(const std::string& text, std::vector<std::string> extra = {}) const {
     std::vector<std::string> overrides = Backend::overrides();
     overrides.insert(overrides.end(), extra.begin(), extra.end());
     return parse_scene(text, "typed", overrides);
@@ -113,25 +93,9 @@ class TerrainTyped : public ::testing::Test {
   std::unique_ptr<Terrain> make(const Scene& s) const {
     return make_terrain(Backend::kName, s, HeightField::from_scene(s));
   }
-  static StampSchedule schedule(const Scene& s) {
-    const HeightField field = HeightField::from_scene(s);
-    return make_schedule(s.tool, s.stroke, [field](const Vec2& p) { return field(p); });
-  }
-  static ErosionRule rule(const Scene& s) {
-    return ErosionRule::from(s.material, s.erosion.settle_tolerance_deg, s.erosion.rule);
-  }
   static void expect_ok(const Terrain& t, const char* when) {
     const IntegrityReport r = t.check();
     EXPECT_TRUE(r.ok()) << when << ": " << ::testing::PrintToString(r.problems);
-  }
-  // Erodes and simplifies until settled; false if it did not settle.
-  static bool relax(Terrain& t, const Scene& s) {
-    for (int passes = 0; passes < 200000; passes += 64) {
-      t.erode(rule(s), ErosionBudget{.max_passes = 64, .settling = true});
-      t.simplify(SimplifyParams{s.tin.alpha_flat_deg});
-      if (t.stats().active == 0) return true;
-    }
-    return false;
   }
 };
 
@@ -145,17 +109,17 @@ using Backends = ::testing::Types<Tin, Grid, Sparse>;
 TYPED_TEST_SUITE(TerrainTyped, Backends, BackendName);
 
 TYPED_TEST(TerrainTyped, VolumeIsKeptByEveryPhase) {
-  for (const char* text : {kFlat, kDunes}) {
+  for (const std::string& text : {kFlat, kDunes}) {
     const Scene s = this->scene(text);
     auto t = this->make(s);
     const double v0 = t->volume();
     const double tol = TypeParam::kVolumeTolerance * v0;
-    for (const ToolStamp& st : this->schedule(s).stamps) {
+    for (const ToolStamp& st : test::schedule_of(s).stamps) {
       const StampReport r = t->stamp(st);
       EXPECT_GE(r.volume_removed_m3, 0.0);
       EXPECT_GT(r.volume_deposited_m3, 0.0);
       EXPECT_NEAR(t->volume(), v0, tol) << "after stamp " << st.generation;
-      t->erode(this->rule(s), ErosionBudget{s.erosion.max_passes_per_step});
+      t->erode(test::rule_of(s), ErosionBudget{s.erosion.max_passes_per_step});
       EXPECT_NEAR(t->volume(), v0, tol) << "after erosion " << st.generation;
       t->simplify(SimplifyParams{s.tin.alpha_flat_deg});
       EXPECT_NEAR(t->volume(), v0, tol) << "after simplification " << st.generation;
@@ -169,11 +133,11 @@ TYPED_TEST(TerrainTyped, PoursAddTheirVolume) {
   auto t = this->make(s);
   const double v0 = t->volume();
   double added = 0.0;
-  for (const ToolStamp& st : this->schedule(s).stamps) {
+  for (const ToolStamp& st : test::schedule_of(s).stamps) {
     t->stamp(st);
     added += st.pour_volume_m3;
     EXPECT_NEAR(t->volume(), v0 + added, TypeParam::kVolumeTolerance * v0);
-    t->erode(this->rule(s), ErosionBudget{s.erosion.max_passes_per_step});
+    t->erode(test::rule_of(s), ErosionBudget{s.erosion.max_passes_per_step});
     EXPECT_NEAR(t->volume(), v0 + added, TypeParam::kVolumeTolerance * v0);
     this->expect_ok(*t, "after a pour");
   }
@@ -181,23 +145,23 @@ TYPED_TEST(TerrainTyped, PoursAddTheirVolume) {
 }
 
 TYPED_TEST(TerrainTyped, SlopesAfterRelaxationAreAtMostCritical) {
-  for (const char* text : {kFlat, kPile}) {
+  for (const std::string& text : {kFlat, kPile}) {
     const Scene s = this->scene(text);
     auto t = this->make(s);
-    for (const ToolStamp& st : this->schedule(s).stamps) {
+    for (const ToolStamp& st : test::schedule_of(s).stamps) {
       t->stamp(st);
-      t->erode(this->rule(s), ErosionBudget{s.erosion.max_passes_per_step});
+      t->erode(test::rule_of(s), ErosionBudget{s.erosion.max_passes_per_step});
       t->simplify(SimplifyParams{s.tin.alpha_flat_deg});
     }
     EXPECT_GT(t->max_slope_deg(), s.material.critical_angle_deg + 1.0) << "the stroke left steep walls";
-    ASSERT_TRUE(this->relax(*t, s));
+    ASSERT_TRUE(test::relax(*t, s));
     this->expect_ok(*t, "after relaxation");
     EXPECT_LE(t->max_slope_deg(), s.material.critical_angle_deg + s.erosion.settle_tolerance_deg + 1e-9);
   }
 }
 
 TYPED_TEST(TerrainTyped, StampReachesItsDepthInsideTheFootprint) {
-  for (const char* text : {kFlat, kDunes}) {
+  for (const std::string& text : {kFlat, kDunes}) {
     const Scene s = this->scene(text);
     auto t = this->make(s);
     const Vec2 c(0.15, 0.15);
@@ -226,8 +190,8 @@ TYPED_TEST(TerrainTyped, StampReachesItsDepthInsideTheFootprint) {
 TYPED_TEST(TerrainTyped, HeightQueriesAgreeWithSample) {
   const Scene s = this->scene(kDunes);
   auto t = this->make(s);
-  for (const ToolStamp& st : this->schedule(s).stamps) t->stamp(st);
-  t->erode(this->rule(s), ErosionBudget{8});
+  for (const ToolStamp& st : test::schedule_of(s).stamps) t->stamp(st);
+  t->erode(test::rule_of(s), ErosionBudget{8});
   Raster r = Raster::covering(s.domain.box(), 0.0035);
   t->sample(r);
   ASSERT_EQ(r.values.size(), r.nx * r.ny);
@@ -238,7 +202,7 @@ TYPED_TEST(TerrainTyped, HeightQueriesAgreeWithSample) {
 TYPED_TEST(TerrainTyped, StatsAndMeshAreConsistent) {
   const Scene s = this->scene(kFlat);
   auto t = this->make(s);
-  for (const ToolStamp& st : this->schedule(s).stamps) t->stamp(st);
+  for (const ToolStamp& st : test::schedule_of(s).stamps) t->stamp(st);
   const ModelStats st = t->stats();
   const SurfaceMesh m = t->mesh();
   EXPECT_GT(st.bytes, 0u);

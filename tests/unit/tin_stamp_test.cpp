@@ -85,7 +85,7 @@ TEST(TinStamp, ManySidedToolsAreCutToWhatTheMeshResolves) {
 }
 
 TEST(TinStamp, ReachesTheToolDepthInsideTheFootprint) {
-  for (const char* text : {kFlatScene, kDunesScene}) {
+  for (const std::string& text : {kFlatScene, kDunesScene}) {
     const Scene s = scene(text);
     auto t = make(s);
     const Vec2 c(0.25, 0.25);

@@ -11,29 +11,19 @@
 #include "common/height_field.hpp"
 #include "common/scene.hpp"
 #include "common/schedule.hpp"
+#include "terrain_test_support.hpp"
 #include "tin/tin_terrain.hpp"
 
 namespace sb::tin::test {
 
 // 0.5 m of flat sand 0.1 m deep; a 2 cm disk cutting 1 cm deep along x.
-inline const char* kFlatScene = R"(
-[domain]
-size_m = [0.5, 0.5]
-[terrain]
-kind = "flat"
-height_m = 0.1
-[material]
-critical_angle_deg = 30.0
-[tool]
-shape = "disk"
-radius_m = 0.02
-depth_m = 0.01
+inline const std::string kFlatScene = sb::test::flat_sand_scene("0.5", "0.1", sb::test::kDisk2cm, R"(
 [stroke]
 path_m = [[0.15, 0.25], [0.35, 0.25]]
 spacing_m = 0.005
-)";
+)");
 
-inline const char* kDunesScene = R"(
+inline const std::string kDunesScene = R"(
 [domain]
 size_m = [0.5, 0.5]
 [terrain]
@@ -56,48 +46,26 @@ spacing_m = 0.005
 tolerance_m = 0.0005
 )";
 
-inline const char* kPileScene = R"(
-[domain]
-size_m = [0.3, 0.3]
-[terrain]
-kind = "flat"
-height_m = 0.05
-[material]
-critical_angle_deg = 30.0
+// 20 pours of 1 cm^3 at the middle of 0.3 m of flat sand 5 cm deep, 8 erosion passes a step.
+inline const std::string kPileScene =
+    sb::test::flat_sand_scene("0.3", "0.05", "shape = \"pour\"\nradius_m = 0.004\nvolume_m3 = 1e-6\n", R"(
 [erosion]
 max_passes_per_step = 8
-[tool]
-shape = "pour"
-radius_m = 0.004
-volume_m3 = 1e-6
 [stroke]
 path_m = [[0.15, 0.15]]
 repeat = 20
-)";
+)");
 
-inline Scene scene(const char* text = kFlatScene, const std::vector<std::string>& overrides = {}) {
+inline Scene scene(const std::string& text = kFlatScene, const std::vector<std::string>& overrides = {}) {
   return parse_scene(text, "test", overrides);
 }
 
 inline std::unique_ptr<Terrain> make(const Scene& s) { return make_tin_terrain(s, HeightField::from_scene(s)); }
 
-inline ErosionRule rule_of(const Scene& s) {
-  return ErosionRule::from(s.material, s.erosion.settle_tolerance_deg, s.erosion.rule);
-}
-
-inline StampSchedule schedule_of(const Scene& s) {
-  const HeightField field = HeightField::from_scene(s);
-  return make_schedule(s.tool, s.stroke, [field](const Vec2& p) { return field(p); });
-}
-
-inline ToolStamp stamp_at(const Scene& s, Vec2 xy, double bottom_z, Vec2 motion = {1.0, 0.0},
-                          std::uint32_t generation = 0) {
-  ToolPose pose;
-  pose.xy = xy;
-  pose.bottom_z = bottom_z;
-  pose.heading_rad = std::atan2(motion.y(), motion.x());
-  return make_stamp(s.tool, pose, motion, generation);
-}
+using sb::test::relax;
+using sb::test::rule_of;
+using sb::test::schedule_of;
+using sb::test::stamp_at;
 
 // One simulation step as the runner does it.
 inline void step(Terrain& t, const Scene& s, const ToolStamp& st) {
@@ -106,27 +74,8 @@ inline void step(Terrain& t, const Scene& s, const ToolStamp& st) {
   t.simplify(SimplifyParams{s.tin.alpha_flat_deg});
 }
 
-// Erodes until the active set is empty (or the pass limit); returns whether it settled.
-inline bool relax(Terrain& t, const Scene& s, int max_passes = 200000) {
-  const ErosionRule rule = rule_of(s);
-  for (int done = 0; done < max_passes; done += 64) {
-    t.erode(rule, ErosionBudget{.max_passes = 64, .settling = true});
-    t.simplify(SimplifyParams{s.tin.alpha_flat_deg});
-    if (t.stats().active == 0) return true;
-  }
-  return false;
-}
-
-#define SB_EXPECT_TIN_OK(terrain)                                                  \
-  do {                                                                             \
-    const ::sb::IntegrityReport integrity_ = (terrain).check();                    \
-    EXPECT_TRUE(integrity_.ok()) << ::testing::PrintToString(integrity_.problems); \
-  } while (0)
-
-#define SB_ASSERT_TIN_OK(terrain)                                                  \
-  do {                                                                             \
-    const ::sb::IntegrityReport integrity_ = (terrain).check();                    \
-    ASSERT_TRUE(integrity_.ok()) << ::testing::PrintToString(integrity_.problems); \
-  } while (0)
+// The TIN tests' names for SB_EXPECT_CHECK_OK and SB_ASSERT_CHECK_OK (terrain_test_support.hpp).
+#define SB_EXPECT_TIN_OK(terrain) SB_EXPECT_CHECK_OK(terrain)
+#define SB_ASSERT_TIN_OK(terrain) SB_ASSERT_CHECK_OK(terrain)
 
 }  // namespace sb::tin::test

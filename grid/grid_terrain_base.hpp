@@ -1,0 +1,128 @@
+#pragma once
+// GridTerrainBase<Heights, Active>: what the dense and the sparse grid terrain share -- the
+// model of a regular height grid (GridTerrain, grid_terrain.hpp) written once over its
+// storage: Heights is HeightGrid<Real> or SparseHeights<Real>, Active the active set that
+// goes with it (ActiveSet or SparseActiveSet). It holds the heights, the neighbour stencil,
+// the active set and the erosion tables, and implements every Terrain operation whose code
+// does not depend on the storage: stamp (the stamp kernel, then the changed nodes and their
+// neighbours join the active set), erode (the erosion kernel with the settling cascade),
+// simplify (nothing to do), volume, stats, mesh, sample, max_slope_deg. The final classes
+// add their name, check() and what their storage needs besides (the sparse grid prunes
+// uniform blocks after settling, the dense one streams its mesh row by row).
+//
+// Costs: those stated in grid_terrain.hpp (dense) and sparse_terrain.hpp (sparse).
+// The member functions are defined here but instantiated only in grid_terrain.cpp and
+// sparse_terrain.cpp (extern template declarations next to each final class).
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "common/height_field.hpp"
+#include "common/scene.hpp"
+#include "common/terrain.hpp"
+#include "grid/erosion_kernel.hpp"
+#include "grid/grid_layout.hpp"
+#include "grid/grid_stamp.hpp"
+#include "grid/grid_surface.hpp"
+#include "grid/multires_settle.hpp"
+#include "grid/stencil.hpp"
+
+namespace sb::grid {
+
+template <class Heights, class Active>
+class GridTerrainBase : public Terrain {
+ public:
+  double height(const Vec2& p) const override { return heights_.height(p); }
+  StampReport stamp(const ToolStamp& s) override;
+  ErosionReport erode(const ErosionRule& rule, const ErosionBudget& budget) override;
+  // Nothing to simplify on a grid: the volume does not change.
+  SimplifyReport simplify(const SimplifyParams&) override { return {.volume_change_m3 = 0.0}; }
+  double volume() const override { return heights_.volume(); }
+  ModelStats stats() const override;
+  SurfaceMesh mesh() const override { return grid_mesh(heights_); }
+  void sample(Raster& out) const override { grid_sample(heights_, out); }
+  double max_slope_deg() const override { return grid_max_slope_deg(heights_, stencil_); }
+
+  // For tests and benchmarks: every node a member of the active set; which sweep erosion
+  // runs (default Auto: the dense pass when the members fill an eighth of their row spans).
+  void activate_all() { active_.activate_all(); }
+  void set_sweep_path(SweepPath path) { sweep_path_ = path; }
+  // Whether large settling budgets start with the multi-resolution cascade (default on;
+  // multires_settle.hpp).
+  void set_multires(bool on) { multires_ = on; }
+  const GridLayout& layout() const { return heights_.layout(); }
+  const Heights& heights() const { return heights_; }
+  const Active& active_set() const { return active_; }
+  const Stencil& stencil() const { return stencil_; }
+
+ protected:
+  // neighbours: 4 or 8; idle_passes: idle visits before a node leaves the active set.
+  GridTerrainBase(const GridLayout& layout, const std::function<double(const Vec2&)>& initial, int neighbours,
+                  int idle_passes)
+      : heights_(layout, initial),
+        stencil_(Stencil::make(layout, neighbours)),
+        active_(layout.nx, layout.ny, idle_passes) {}
+
+  Heights heights_;
+  Stencil stencil_;
+  Active active_;
+
+ private:
+  SweepPath sweep_path_ = SweepPath::Auto;
+  bool multires_ = true;
+  std::optional<ErosionTables> tables_;  // built on the first erode, rebuilt when the rule changes
+};
+
+template <class Heights, class Active>
+StampReport GridTerrainBase<Heights, Active>::stamp(const ToolStamp& s) {
+  std::vector<std::uint32_t> changed;
+  const double carry_before = heights_.carry_m3();
+  StampReport report = stamp_grid(heights_, s, changed);
+  // What the stored volume changed by: the stamp's own sums, less what rounding put into
+  // the carry (zero in double).
+  report.volume_change_m3 =
+      report.volume_deposited_m3 - report.volume_removed_m3 - (heights_.carry_m3() - carry_before);
+  const GridLayout& layout = heights_.layout();
+  for (std::uint32_t k : changed) {
+    const auto [ix, iy] = layout.split(k);
+    active_.activate_block(ix, iy);
+  }
+  return report;
+}
+
+template <class Heights, class Active>
+ErosionReport GridTerrainBase<Heights, Active>::erode(const ErosionRule& rule, const ErosionBudget& budget) {
+  const bool gradient = rule.needs_gradient();
+  if (!tables_ || !tables_->built_for(rule, gradient))
+    tables_.emplace(heights_.layout(), stencil_.size, rule, gradient);
+  const double carry_before = heights_.carry_m3();
+  ErosionReport report = erode_settling(heights_, active_, *tables_, budget, sweep_path_, multires_);
+  // Transfers conserve volume; only rounding into the carry changes the stored volume.
+  report.volume_change_m3 = carry_before - heights_.carry_m3();
+  return report;
+}
+
+template <class Heights, class Active>
+ModelStats GridTerrainBase<Heights, Active>::stats() const {
+  ModelStats st;
+  st.cells = heights_.layout().nodes();
+  st.bytes = heights_.bytes() + active_.bytes() + (tables_ ? tables_->bytes() : 0);
+  st.active = active_.size();
+  return st;
+}
+
+// The grid terrain Model<float> or Model<double>, as the scene's [grid] storage says, on
+// the layout of its [grid] cell size with its neighbours and [erosion] idle passes: the
+// factory both grids share (make_grid_terrain, make_sparse_terrain).
+template <template <class> class Model>
+std::unique_ptr<Terrain> make_grid_model(const Scene& scene, const HeightField& initial) {
+  const GridLayout layout = GridLayout::covering(scene.domain.box(), scene.grid.cell_m);
+  const auto z0 = [&initial](const Vec2& p) { return initial(p); };
+  if (scene.grid.storage == GridStorage::Float)
+    return std::make_unique<Model<float>>(layout, z0, scene.grid.neighbours, scene.erosion.idle_passes);
+  return std::make_unique<Model<double>>(layout, z0, scene.grid.neighbours, scene.erosion.idle_passes);
+}
+
+}  // namespace sb::grid
