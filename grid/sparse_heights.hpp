@@ -122,10 +122,16 @@ class SparseHeights {
     }
   }
   // Stores values[0..x1 - x0] at nodes x0..x1 of row iy where they differ (in bits) from
-  // before[...], as put() would (the values are already rounded: no carry). O(x1 - x0).
+  // before[...], the heights the store holds there, as put() would (the values are already
+  // rounded: no carry). O(x1 - x0). A block's row of up to 8 nodes is compared at once, without
+  // a branch per node, and written whole where one of them changed: the others get the bits they
+  // hold (before), so the heights, leaves and dirty blocks are those of put() node by node.
   void write_changed(std::size_t iy, std::size_t x0, std::size_t x1, const Real* values, const Real* before) {
-    for (std::size_t x = x0; x <= x1; ++x, ++values, ++before)
-      if (!same_bits(*values, *before)) store(x, iy, *values);
+    for (std::size_t x = x0; x <= x1;) {
+      const std::size_t n = std::min(kBlock - (x & 7), x1 - x + 1);
+      if (!same_bits(values, before, n)) store(x, iy, values, n);
+      values += n, before += n, x += n;
+    }
   }
 
   double height(const Vec2& p) const { return bilinear_height(*this, p); }
@@ -162,6 +168,13 @@ class SparseHeights {
     using Bits = std::conditional_t<sizeof(Real) == 8, std::uint64_t, std::uint32_t>;
     return std::bit_cast<Bits>(a) == std::bit_cast<Bits>(b);
   }
+  // The same for a[0..n - 1] and b[0..n - 1].
+  static bool same_bits(const Real* a, const Real* b, std::size_t n) {
+    using Bits = std::conditional_t<sizeof(Real) == 8, std::uint64_t, std::uint32_t>;
+    Bits differ = 0;
+    for (std::size_t i = 0; i < n; ++i) differ |= std::bit_cast<Bits>(a[i]) ^ std::bit_cast<Bits>(b[i]);
+    return differ == 0;
+  }
   std::size_t block_index(std::size_t ix, std::size_t iy) const { return (iy >> 3) * blocks_x_ + (ix >> 3); }
   // (ix, iy) of node k without a division: k / nx as the high half of k * ceil(2^64 / nx),
   // exact for every k < 2^32 (erosion reads ~10 heights per visit by node index).
@@ -178,6 +191,18 @@ class SparseHeights {
       materialise(bi);
     }
     data_[bi][voxel_offset(ix, iy)] = stored;
+    if (!(state & kDirty)) {
+      state |= kDirty;
+      dirty_.push_back(static_cast<std::uint32_t>(bi));
+    }
+  }
+  // values[0..n - 1] at nodes ix..ix + n - 1 of row iy, all in one block, one of them other than
+  // the height the block holds there (so a tile block gets its leaf, as store() would).
+  void store(std::size_t ix, std::size_t iy, const Real* values, std::size_t n) {
+    const std::size_t bi = block_index(ix, iy);
+    std::uint8_t& state = state_[bi];
+    if (!(state & kLeaf)) materialise(bi);
+    std::copy(values, values + n, data_[bi] + voxel_offset(ix, iy));
     if (!(state & kDirty)) {
       state |= kDirty;
       dirty_.push_back(static_cast<std::uint32_t>(bi));
