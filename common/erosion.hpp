@@ -22,7 +22,10 @@
 //     pile.toml lobed (RMSE 80 um, roundness 0.040, against 55 um and 0.024 uncapped); with
 //     the steepest facet at rest, the pile's RMSE is 50 um (flank 29.76 degrees against
 //     29.43), the relaxed cone.toml's 54-56 um at 35..60 degrees (59-69 uncapped), the trench
-//     sections' mean as before. A plane is then at rest at the
+//     sections' mean as before (0.07 degrees from critical), their worst single section 1.36
+//     degrees off against 1.24, and a relaxed plane's steepest facet 30.9 against 30.5 degrees
+//     (results/orientation_worst.md: the cap holds back transfers a noisy facet would have
+//     made). A plane is then at rest at the
 //     critical angle in every azimuth and a steeper plane is not; where |g| <= tan_settle
 //     (peaks, pits, kinks, gentle slopes) and toward neighbours sideways or uphill of u, only
 //     the edge rule acts, so no edge ever rests steeper than under the edge rule. The
