@@ -162,8 +162,9 @@ class TinTerrain final : public Terrain {
   };
   FaceHandle start_face(const Walk& walk) const;
   Location locate(const Vec2& p, Walk& walk) const;
-  Location locate(const Vec2& p) const { return locate(p, edit_walk_); }  // an edit's
-  // height() for the model's own edits (the stamp's contours, a split's middle): the edits' walk.
+  // locate() and height() for the model's own edits (the stamp's contours, a split's middle):
+  // the edits' walk. height() and sample() take query_walk_.
+  Location locate(const Vec2& p) const { return locate(p, edit_walk_); }
   double surface_height(const Vec2& p) const { return height_by(p, edit_walk_); }
   double height_by(const Vec2& p, Walk& walk) const;
   double interpolate(FaceHandle f, const Vec2& p) const;
