@@ -92,9 +92,10 @@ VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* insert
   // The split itself keeps the surface; the Delaunay flips after it may not: their volume
   // change (measured over the faces the insertion replaced) is given back to the new vertex
   // (tin.conserve_volume, the default).
+  volume_change_ += change;
   if (spec_.conserve_volume && change != 0.0) {
     const double area = vertex_area(v);
-    if (area > 0.0) set_z(v, v->point().z() - change / area);
+    if (area > 0.0) shift_z(v, v->point().z() - change / area, area);
   }
   touch_with_neighbours(v);
   return v;
@@ -187,6 +188,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
       rule.tan_critical < 0.0 || rule.fraction < 0.0)
     throw InputError("erosion: the rule's slopes and fraction must be finite and non-negative");
   ErosionReport report;
+  volume_change_ = 0.0;
   std::vector<VertexHandle>& work = work_scratch_;
   // The gradient rule's input: the area-weighted facet gradients of v's star (gather_neighbours
   // lists the neighbours counter-clockwise, so consecutive ones span v's triangles).
@@ -226,7 +228,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
       // fraction of the excess, so each slope settles in O(log(excess / tolerance)) visits,
       // and with the mesh refined no finer than refine_m_ the work is bounded.
       if (total > 0.0 && area > 0.0) {
-        set_z(v, v->point().z() - total / area);
+        shift_z(v, v->point().z() - total / area, area);
         // One ring: v fell, so its neighbours' drops towards v grew; a receiver rose, which
         // only its own drops grow (its neighbours' drops towards it shrank).
         // (vertex_scratch_ holds v's neighbours: no second circulation.)
@@ -236,7 +238,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
         for (std::size_t k = 0; k < ring_n_; ++k) {
           if (transfer_scratch_[k] <= 0.0 || nbr_scratch_[k].area <= 0.0) continue;
           const VertexHandle w = vertex_scratch_[k];
-          set_z(w, w->point().z() + transfer_scratch_[k] / nbr_scratch_[k].area);
+          shift_z(w, w->point().z() + transfer_scratch_[k] / nbr_scratch_[k].area, nbr_scratch_[k].area);
           // The gradient rule reads w's height in its neighbours' fan gradients too.
           if (rule.needs_gradient())
             touch_with_neighbours(w);
@@ -262,6 +264,7 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
     compact_ring_pool(2 * ring_pool_live_);
   }
   report.active = erosion_list_.size();
+  report.volume_change_m3 = volume_change_;
   return report;
 }
 

@@ -83,7 +83,7 @@ void TinTerrain::settle_with_cascade(const ErosionRule& rule, const ErosionBudge
   for (std::size_t i = 0; i < n; ++i) {
     const VertexHandle v = vertices[i];
     if (region.z[i] == v->point().z()) continue;
-    set_z(v, region.z[i]);
+    shift_z(v, region.z[i], region.area[i]);
     touch_with_neighbours(v);
     add_to_simplify(v);
   }

@@ -116,12 +116,12 @@ void TinTerrain::thin_passed_contours(const std::vector<std::pair<VertexHandle, 
 
 void TinTerrain::spread_volume(const std::vector<VertexHandle>& vertices, double volume) {
   double total = 0.0;
-  for (VertexHandle v : vertices) total += vertex_area(v);
+  for (VertexHandle v : vertices) total += cached_area(v);
   if (volume == 0.0 || !(total > 0.0)) return;
   // Raising every vertex by the same dz changes the volume by dz times their areas' sum.
   const double dz = volume / total;
   for (VertexHandle v : vertices) {
-    set_z(v, v->point().z() + dz);
+    shift_z(v, v->point().z() + dz, cached_area(v));
     touch_with_neighbours(v);
     add_to_simplify(v);
   }
@@ -151,14 +151,17 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   // The constraints of stamps that have passed only kept their walls from being flipped:
   // dropped, so the surface between old stamps is free to relax and coarsen (the Delaunay
   // triangulation minimises roughness, Rippa 1990).
+  volume_change_ = 0.0;
   std::vector<VertexHandle> stale_region;
   const double unconstrained = drop_stale_constraints(s.generation, stale_region);
+  volume_change_ += unconstrained;
   stale_delta_ = spec_.conserve_volume ? unconstrained : 0.0;
   if (s.is_pour()) return pour(s);
   StampReport report;
   StampWork w;
   if (!plan_stamp(s, w)) {  // off the domain: no deposit to give the flips' change back with
     spread_volume(stale_region, -stale_delta_);
+    report.volume_change_m3 = volume_change_;
     return report;
   }
   contour_points(w);  // 1a
@@ -175,6 +178,7 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   // The retriangulation's own volume change (flips, removals of non-planar vertices).
   std::vector<VertexHandle> region_vertices;
   const CaptureResult measured = end_capture(capture, &region_vertices);
+  volume_change_ += measured.delta();
   const double surface_change = measured.delta() + w.lowered_volume;
   // Constraint changes retriangulate inside the region, beyond the inserted vertices' stars.
   for (VertexHandle v : region_vertices) forget_caches(v);
@@ -185,6 +189,7 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   activate(w, region_vertices);  // 1f
   report.volume_removed_m3 = w.lowered_volume;
   report.elements_touched = measured.faces_after;
+  report.volume_change_m3 = volume_change_;
   return report;
 }
 
@@ -526,7 +531,7 @@ double TinTerrain::deposit_on_rim(StampWork& w, double deposit, StampReport& rep
   for (const auto& [v, wa] : targets) {
     const double a = cached_area(v);
     if (a <= 0.0) continue;
-    set_z(v, v->point().z() + deposit * (wa / weight_sum) / a);
+    shift_z(v, v->point().z() + deposit * (wa / weight_sum) / a, a);
     w.changed.push_back(v);
   }
   return deposit;
@@ -596,6 +601,7 @@ StampReport TinTerrain::pour(const ToolStamp& s) {
   }
   std::vector<VertexHandle> region_vertices;
   const CaptureResult measured = end_capture(capture, &region_vertices);
+  volume_change_ += measured.delta();
 
   // The volume lands as a cone of the pour radius (weights 1 - d / r times vertex areas), on
   // vertices with short edges (refine_around), so the sand stays within the radius.
@@ -619,7 +625,7 @@ StampReport TinTerrain::pour(const ToolStamp& s) {
   for (const auto& [v, wa] : targets) {
     const double a = cached_area(v);
     if (a <= 0.0) continue;
-    set_z(v, v->point().z() + volume * (wa / weight_sum) / a);
+    shift_z(v, v->point().z() + volume * (wa / weight_sum) / a, a);
     touch_with_neighbours(v);
     add_to_simplify(v);
   }
@@ -627,6 +633,7 @@ StampReport TinTerrain::pour(const ToolStamp& s) {
   for (VertexHandle v : fresh) add_to_simplify(v);
   report.volume_deposited_m3 = weight_sum > 0.0 ? volume : 0.0;
   report.elements_touched = measured.faces_after;
+  report.volume_change_m3 = volume_change_;
   return report;
 }
 

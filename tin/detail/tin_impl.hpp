@@ -191,7 +191,15 @@ class TinTerrain final : public Terrain {
   void record_unrecorded_constraints(std::uint32_t generation);
   bool has_constraints(VertexHandle v) const;
   double vertex_area(VertexHandle v) const;
+  // A height write inside an open capture (begin_capture ... end_capture), which measures it.
   void set_z(VertexHandle v, double z);
+  // A height write outside any capture: `area` is v's barycentric area now (the integral's
+  // derivative in z_v), and area x (new - old z) joins volume_change_.
+  void shift_z(VertexHandle v, double z, double area) {
+    const double before = v->point().z();
+    set_z(v, z);
+    volume_change_ += area * (v->point().z() - before);
+  }
   // The cached area (computed when stale); and forgetting the caches of v and its neighbours,
   // whose stars change when v's does. Every change of the triangulation goes through
   // insert_point, remove_vertex, or a stamp, which forget the caches of the region they touched.
@@ -347,6 +355,11 @@ class TinTerrain final : public Terrain {
   std::uint32_t face_epoch_ = 0;
   std::uint32_t vertex_epoch_ = 0;
   std::size_t capture_mismatches_ = 0;  // regions whose area changed: a broken assumption
+  // The volume change of the current phase (stamp, erode, simplify) from the edits' own
+  // bookkeeping: shift_z's A dz, and the measured change of every retriangulation (captures,
+  // split_edge's flips). Each phase starts it at 0 and reports it as volume_change_m3, so the
+  // runner integrates the surface (volume(), O(n)) only at the start and the end of a run.
+  double volume_change_ = 0.0;
 
   // Scratch reused across calls (counted in stats().bytes).
   std::vector<ErosionNeighbour> nbr_scratch_;
