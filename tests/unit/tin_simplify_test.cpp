@@ -159,6 +159,28 @@ TEST(TinSimplify, CoarseningRemovesSettledNearPlanarVerticesAndKeepsTheVolume) {
   }
 }
 
+// A rest scan over a large flat TIN removes nearly every vertex, each with a capture that
+// locates the vertex: the walk must start there, not wherever the last edit left the hint.
+// From the stroke's end, every removal walked across the mesh (measured here: 186 faces a
+// removal; flat_stroke.toml at 10^5 initial points 144, at 10^6 most of 12 s of a 22 s run);
+// from the vertex, 1.0 here.
+TEST(TinSimplify, ARestScanWalksO1FacesPerRemoval) {
+  const Scene s = scene(kFlatScene, {"tin.initial_points=40000"});
+  auto t = make(s);
+  t->stamp(stamp_at(s, {0.05, 0.05}, 0.09));  // the edits' walk ends in a corner
+  const std::uint64_t before = t->stats().walk_steps;
+  std::size_t removed = 0;
+  for (int chunk = 0; chunk < 100 && t->stats().active > 0; ++chunk)
+    t->erode(rule_of(s), ErosionBudget{.max_passes = 64, .settling = true});
+  removed += t->simplify(SimplifyParams{s.tin.alpha_flat_deg}).removed;  // the scan at rest
+  ASSERT_EQ(t->stats().active, 0u);
+  ASSERT_GT(removed, 30000u);
+  const double per_removal = static_cast<double>(t->stats().walk_steps - before) / static_cast<double>(removed);
+  RecordProperty("walk_steps_per_removal", std::to_string(per_removal));
+  EXPECT_LT(per_removal, 4.0);
+  SB_EXPECT_TIN_OK(*t);
+}
+
 TEST(TinSimplify, RefusesABadAngle) {
   const Scene s = scene();
   auto t = make(s);
