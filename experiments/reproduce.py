@@ -152,9 +152,19 @@ notes); the tables below are this run's.
   ring's cotangent weights and fan-gradient coefficients once per star (as the cascade's fine level does)
   was tried: 1,206 instructions a visit on the pile (its step 0.202 -> 0.185 ms, 9 interleaved rounds),
   but no gain on the trench or `flat_stroke.toml` (stamps re-walk the stars about every ten visits: 0.78 ->
-  0.79 and 0.70 -> 0.71 ms), for the pile's peak memory 119 -> 195 kB (the grid's: 163): not kept. A
-  compact, index-based mesh could narrow the first factor (**our code**, not attempted); the rest is **the
-  method**.
+  0.79 and 0.70 -> 0.71 ms), for the pile's peak memory 119 -> 195 kB (the grid's: 163): not kept. How
+  much a compact, index-based mesh could buy, measured (a build timing each kind of visit, two or three
+  runs per scene, both kinds in the same runs): the same rule over plain arrays of rings (the cascade's
+  fine level: no CGAL handle read, geometry laid out) against the TIN's own settling passes through
+  CGAL's handles, 98 against 111-120 ns a visit (`pile.toml` poured 200 times), 88 against 120-128
+  (`flat_stroke.toml` with `tool.depth_m = 0.2`), 88-118 against 80 (trench). During a stroke a visit
+  costs 187-189 ns (pile), 226-239 (`flat_stroke.toml`) and 251-256 (trench), of which edge splits, a
+  CGAL insertion of 2.0-2.7 us each, are about a fifth (346 splits on the pile, 2029 on the trench). So
+  the data structure is at most a quarter of a settled visit (**our code**, not pursued: it could not
+  bring the pile's step within 3x the grid's); the rest at rest is the rule's scalar arithmetic over an
+  irregular ring (about 700 instructions, against about 40 a node in the grid's eight lanes), which we
+  have not vectorised across a ring (**our code**, open); a stroke's extra cost is the mesh adapting
+  around the tool (splits, stars re-walked after every stamp): **the method**.
 - **TIN settling after a deep stroke** (`flat_stroke.toml` with `tool.depth_m = 0.2`): was **our code**,
   fixed. The TIN needed 361k settling updates where the grid needs 97k, because the grid settles with a
   coarse-to-fine cascade and the TIN settled with fine passes only, whose diffusive tail (the last quarter
@@ -225,7 +235,12 @@ notes); the tables below are this run's.
   but made the pile worse, RMSE 53 -> 71 um; capping the cotangents did not settle them.)
 - **TIN simplification**: was **our code** (the paper's step 3 never removed a vertex on a flat bed), fixed:
   once the terrain is at rest, near-planar vertices are removed (volume kept, no triangle tilted past the
-  stable slope), tens per shipped scene; during strokes the paper's alpha_flat rule alone acts.
+  stable slope), tens per shipped scene; during strokes the paper's alpha_flat rule alone acts. On large
+  TINs that scan was **our code** too, fixed: each removal located its vertex by walking from wherever the
+  last edit had left the walk, O(sqrt(n)) faces (`flat_stroke.toml` on 10^6 initial points, 974k
+  removals: 441 M walk steps, settling 18.5 s of a 22.3 s run); it now starts at the vertex (1.8 M steps,
+  11 s). And the runner integrated the TIN's surface after every phase (23 % of those 11 s): the TIN now
+  reports each phase's volume change from its own bookkeeping. The run takes 7.2 s, settling 5.8 s.
 - **TIN trench walls**: the paper's edge rule leaves them 1-4 degrees steeper than critical (a triangle
   whose edges are all stable can stand steeper); the gradient rule brings their mean to within 0.1
   degree of critical at every azimuth (orientation table): **the rule**, now fixed by default. Single
