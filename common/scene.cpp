@@ -356,6 +356,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   s.erosion.settle_tolerance_deg = f.number("erosion.settle_tolerance_deg", 0.1, closed(0.0, 10.0));
   s.erosion.relax_at_end = f.boolean("erosion.relax_at_end", true);
   s.erosion.relax_max_passes = static_cast<int>(f.integer("erosion.relax_max_passes", 20000, 0, 100000000));
+  s.erosion.cascade = f.boolean("erosion.cascade", true);
   s.erosion.rule = f.choice("erosion.rule", "gradient", {"gradient", "edge"}) == "gradient" ? ErosionRuleKind::Gradient
                                                                                             : ErosionRuleKind::Edge;
 

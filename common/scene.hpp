@@ -51,6 +51,9 @@ struct ErosionSpec {
   double settle_tolerance_deg = 0.1;  // slopes up to critical + this count as stable
   bool relax_at_end = true;           // after the stroke, erode until settled
   int relax_max_passes = 20000;
+  // Settling starts with the back-end's coarse-to-fine cascade (faster on large disturbances; on
+  // a spreading pile it leaves the flank flatter than the fine rule would: README, erosion.cascade).
+  bool cascade = true;
   // "gradient" (at rest at the critical angle in every azimuth) or "edge" (the paper's
   // rule: neighbour directions only); see common/erosion.hpp.
   ErosionRuleKind rule = ErosionRuleKind::Gradient;

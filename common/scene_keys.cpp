@@ -30,6 +30,9 @@ std::string scene_key_meaning(const std::string& key) {
       {"erosion.settle_tolerance_deg", "slopes up to critical + this count as stable"},
       {"erosion.relax_at_end", "settle after the stroke (recorded as steps with stamp -1)"},
       {"erosion.relax_max_passes", "at most this many settling passes"},
+      {"erosion.cascade",
+       "settling starts with a coarse-to-fine cascade (much faster on large disturbances, but a spreading pile "
+       "ends flatter); false: the fine rule alone"},
       {"erosion.rule",
        "\"gradient\" (default): also along the downhill gradient, so a surface rests at the critical angle in "
        "every azimuth; \"edge\": slopes along neighbour directions only (the paper's)"},

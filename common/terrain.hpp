@@ -39,6 +39,9 @@ struct ErosionBudget {
   // interactive step). A back-end may spend work here that only pays at rest; the TIN refines
   // creases then when tin.curvature_when = "settling".
   bool settling = false;
+  // Settling budgets may start with a back-end's coarse-to-fine cascade (erosion.cascade): the
+  // grid's multires_settle, the TIN's clusters. false: the fine rule's own passes only.
+  bool cascade = true;
 };
 
 struct ErosionReport {

@@ -19,10 +19,10 @@ from sweep_checks import sidecars  # noqa: E402  {finished run: (sidecar mtime, 
 FIGURES = ["fig5_tin_shaded.png", "fig5_tin_wireframe.png", "fig6_grid_shaded.png", "fig5_6_side_by_side.png",
            "fig5_6_difference.png", "fig7_time_vs_size.png", "fig8_time_vs_trace.png", "fig9_elements_vs_trace.png",
            "memory.png", "drift.png", "alpha_flat.png", "accuracy_speed.png", "orientation.png", "settling.png",
-           "pile_relax.png"]
+           "pile_relax.png", "cascade.png"]
 TABLES = ["fig7_time_vs_size", "fig8_time_vs_trace", "fig9_elements_vs_trace", "memory", "drift", "alpha_flat",
           "accuracy", "orientation_cases", "orientation_trench", "orientation_worst", "settling",
-          "pile_relax"]
+          "pile_relax", "cascade"]
 
 
 def main():

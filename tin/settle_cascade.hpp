@@ -66,6 +66,12 @@
 // vertices it changed, with their neighbours, into L_e: the state returned is at repose under
 // the fine rule whenever the fine passes empty L_e, as without the cascade.
 //
+// Accuracy: as the grid's (grid/multires_settle.hpp, "Accuracy"), a pile spreading over many
+// clusters ends flatter, more so with every level: pile.toml on 10^5 initial points, RMSE 11, 91
+// and 207 um with 0, 1 and both of its 2 levels (flank 30.03, 29.20, 26.63 degrees). With
+// ErosionBudget::cascade false (erosion.cascade) the TIN builds no cluster level and runs only the
+// fine level, which is the fine rule itself over arrays.
+//
 // When (cascade_pays): the runner's settling budgets only (at least kCascadeMinPasses passes,
 // at least 8 updates per active vertex), with at least kCascadeMinActive active vertices;
 // interactive and stroke steps (4 passes) stay local. (pile.toml settles from about 270

@@ -74,6 +74,8 @@ void TinTerrain::settle_with_cascade(const ErosionRule& rule, const ErosionBudge
   CascadeOptions options;
   options.fine_level = true;
   options.cell_m = refine_m_;
+  // erosion.cascade = false: no clusters; the fine level is the fine rule itself (over arrays).
+  if (!budget.cascade) options.max_levels = 0;
   const CascadeReport cr = settle_cascade(region, rule, options);
   if (cr.levels.empty() && cr.fine.updates == 0) return;
   ++report.passes;

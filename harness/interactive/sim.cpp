@@ -140,8 +140,8 @@ void Simulation::step() {
     double erosion_ms = 0.0, simplify_ms = 0.0;
     if (active_.erosion && (stamped || active_set_ > 0)) {
       sw.restart();
-      const ErosionReport er =
-          terrain_->erode(rule_, ErosionBudget{active_.erosion_passes, active_.erosion_updates, !stamped});
+      const ErosionReport er = terrain_->erode(rule_, ErosionBudget{active_.erosion_passes, active_.erosion_updates,
+                                                                    !stamped, prepared_.scene.erosion.cascade});
       erosion_ms = 1e3 * sw.seconds();
       active_set_ = er.active;
       changed |= er.transfers > 0;

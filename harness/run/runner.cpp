@@ -190,7 +190,8 @@ RunResult run_schedule(Terrain& terrain, const PreparedScene& p, const RunCallba
     while (passes_left > 0 && terrain.stats().active > 0) {
       const int passes = static_cast<int>(std::min<long long>(passes_left, 64));
       StepRecord r;
-      erode_and_simplify(terrain, p, ErosionBudget{.max_passes = passes, .settling = true}, r, volume);
+      const ErosionBudget budget{.max_passes = passes, .settling = true, .cascade = p.scene.erosion.cascade};
+      erode_and_simplify(terrain, p, budget, r, volume);
       passes_left -= passes;
       r.volume_m3 = volume;
       record_model(r, terrain.stats());
