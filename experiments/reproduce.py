@@ -214,9 +214,11 @@ notes); the tables below are this run's.
   give-back lowers the new vertex by up to 0.3 mm, leaving pits below the bed where no tool went; spreading
   it over the new vertex's star removes most of them but left the RMSE unchanged (56-58 um), so it was not
   kept. **The method, for the rest**: a piecewise-linear cone on 7 mm edges errs near its apex and toe,
-  and the accuracy table's TIN points trade step time for it (4 mm refinement 43 um at 2-3x the default
-  TIN's step; 2 mm 39 um at 5-8x; curvature refinement at 0.2 mm 38 um at 2-3x: 1.1x the grid's error
-  at 9x its step time; the ratios vary that much between runs of the table), none of them below the grid's curve.
+  and the accuracy table's TIN points trade step time for it (refined to 4 mm: 55 um at 2.3x the default
+  TIN's step; to 2 mm: 51 um at 5.4x; curvature refinement at 0.2 mm: 35 um at 2.1x, where the grids
+  reach 33 um at 2 mm and 28 at 1 mm for a fifth to a quarter of that step time; all settled by the fine
+  rule alone, as `pile.toml` now asks, and the ratios vary between runs of the table), none of them below
+  the grid's curve.
   The TIN's own way out, refining only the surface at rest (`tin.curvature_when = "settling"`, "tin curved
   0.2 mm at rest" in the accuracy table): its steps cost what the default TIN's do (the tool's steps are
   not at rest), and with the drop cap it ends at 41 um (1.16x the grid's) at `tin.curvature_tolerance_m =
@@ -287,8 +289,9 @@ notes); the tables below are this run's.
   table showed the grid's pile worse at 1 mm cells than at 2 mm (107 against 33 um) for that reason alone:
   with the fine rule alone it is 28 um at 1 mm and 25 at 0.5 mm, for 6.6x and 8.9x the settling time; a
   TIN of 10^5 initial points went from 11 to 207 um (flank 26.6 instead of 30.0 degrees) for half the
-  time. Trench walls, which sand falls from rather than spreads over, keep their angle within 0.05
-  degrees either way. `erosion.cascade` now chooses; `pile.toml`, the accuracy reference, settles without
+  time. Not always in that direction: on the TIN refined to 2 mm only where the sand flows, the cascade's
+  pile came out closer to the cone (37 against 51 um). Trench walls, which sand falls from rather than
+  spreads over, keep their angle within 0.05 degrees either way. `erosion.cascade` now chooses; `pile.toml`, the accuracy reference, settles without
   it, the stroke scenes with it (the cascade table below has both).
 - **Sparse grid on the trench** (memory 0.39x the dense grid's, not a fifth): **the method**. Memory
   follows the disturbed area in whole 8 x 8 blocks at 8.6 bytes per node; a long trench disturbs about a
