@@ -218,7 +218,16 @@ notes); the tables below are this run's.
   TIN's step; to 2 mm: 51 um at 5.4x; curvature refinement at 0.2 mm: 35 um at 2.1x, where the grids
   reach 33 um at 2 mm and 28 at 1 mm for a fifth to a quarter of that step time; all settled by the fine
   rule alone, as `pile.toml` now asks, and the ratios vary between runs of the table), none of them below
-  the grid's curve.
+  the grid's curve. Refining by splitting edges at their middles is itself a cost (**our code**, open): the
+  same scene on a TIN started from a regular lattice (`tin.initial_points`, jittered; erosion then has
+  nothing to split) rests at 18 um with 2 mm spacing (0.5x the grid's error; 1508 vertices after
+  coarsening, step 0.40 ms), where splitting to 2 mm gives 51 um at 1.38 ms (3536 vertices); a 4.2 mm
+  lattice steps in 0.12 ms (2.1x the grid's) at 64 um, a 3 mm one in 0.22 ms at 40 um (single runs; a
+  5.5 mm lattice came out lobed, 195 um, so the lattice's orientation to the flow matters). The splits'
+  mesh has irregular valences and slivers, and its splits (CGAL insertions during the stroke) are a fifth
+  of the stroke's erosion time. A refinement that inserts the points of a regular lattice where sand
+  flows, instead of edge middles, is the next lever on the pile's step and error; a lattice over the
+  whole domain from the start costs memory (0.4-3.8 MB against the grid's 0.16).
   The TIN's own way out, refining only the surface at rest (`tin.curvature_when = "settling"`, "tin curved
   0.2 mm at rest" in the accuracy table): its steps cost what the default TIN's do (the tool's steps are
   not at rest), and with the drop cap it ends at 41 um (1.16x the grid's) at `tin.curvature_tolerance_m =
