@@ -27,20 +27,11 @@ void PrintTo(const Case& c, std::ostream* os) { *os << c.name; }
 
 // A non-convex tool whose stroke leaves the domain: stamps off the domain give the flips of
 // the ones before back by spreading them.
-const std::string kPolygonOffDomain = R"(
-[domain]
-size_m = [0.3, 0.3]
-[terrain]
-kind = "flat"
-height_m = 0.05
-[tool]
-shape = "polygon"
-polygon_m = [[-0.02, -0.02], [0.02, -0.02], [0.02, 0.02], [0.0, 0.002], [-0.02, 0.02]]
-depth_m = 0.01
-[stroke]
-path_m = [[0.15, 0.12], [0.36, 0.2]]
-spacing_m = 0.006
-)";
+const std::string kPolygonOffDomain = sb::test::flat_sand_scene(
+    "0.3", "0.05",
+    "shape = \"polygon\"\npolygon_m = [[-0.02, -0.02], [0.02, -0.02], [0.02, 0.02], [0.0, 0.002], [-0.02, 0.02]]\n"
+    "depth_m = 0.01\n",
+    "[stroke]\npath_m = [[0.15, 0.12], [0.36, 0.2]]\nspacing_m = 0.006\n");
 
 std::vector<Case> cases() {
   return {
