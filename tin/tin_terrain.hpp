@@ -34,10 +34,12 @@
 //                     fresh; no allocation per visit (scratch and pool grow amortized).
 //                     Settling budgets (the runner's, >= 32 passes) with >= 512 active
 //                     vertices first run a coarse-to-fine cascade over the region around L_e
-//                     (settle_cascade.hpp: clusters of refinement-length cells, then the fine
-//                     rule over plain arrays), O(region x degree) plus its visits
+//                     (settle_cascade.hpp: clusters of refinement-length cells, none with
+//                     erosion.cascade = false, then the fine rule over plain arrays),
+//                     O(region x degree) plus its visits
 //   simplify          detect O(|L_r| * degree); removal O(degree) per vertex; with
-//                     tin.coarsen, once per rest after activity: detect O(n * degree)
+//                     tin.coarsen, once per rest after activity: detect O(n * degree), each
+//                     removal's capture located from the vertex itself, O(1)
 //   one step          stamp + 4 erosion passes + simplify: 0.6 to 0.7 ms CPU at every n from
 //                     10^3 to 10^6, on tin.initial_points TINs with their border points too,
 //                     log-log slope -0.006 (tests/bench/tin_step_bench.cpp; 0.73 ms on the
@@ -51,7 +53,9 @@
 // removals of not quite planar vertices, dropped constraints). tin.conserve_volume (the
 // default) measures each such change over the faces it touched and gives it back (to the
 // rim deposit, the split vertex, the hole's vertices): exact to rounding, at the cost of one
-// local face traversal per split and per removal.
+// local face traversal per split and per removal. Either way each phase reports its volume
+// change (volume_change_m3: A dz per height written, plus each retriangulation's measured
+// change), O(1) per edit, so the runner integrates the surface only at a run's start and end.
 // Point location walks from the last located face; its guard uses the data structure's O(1)
 // face count (CGAL's number_of_faces() circulates the hull: O(sqrt(n)) with border points).
 // Stale constraints (of stamps before the current one) are dropped at each stamp, and with
