@@ -4,6 +4,7 @@
 // with check() after every step, and the same with curvature refinement. About 30 s in Release.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdio>
 #include <numbers>
 #include <random>
@@ -56,22 +57,26 @@ struct Runner {
   explicit Runner(const Scene& s)
       : scene(s), terrain(make_tin_terrain(s, HeightField::from_scene(s))), rule(test::rule_of(s)) {}
 
-  // One step with check() after each phase; returns false (after reporting) on a problem.
+  // One step with check() after each phase, and the phase's reported volume change against
+  // volume() (the runner's bookkeeping); returns false (after reporting) on a problem.
   bool step(ToolStamp st) {
     st.generation = generation++;
-    terrain->stamp(st);
+    double tracked = terrain->volume();
+    tracked += terrain->stamp(st).volume_change_m3;
     volume_added += st.is_pour() ? st.pour_volume_m3 : 0.0;
-    if (!ok("stamp")) return false;
-    terrain->erode(rule, ErosionBudget{scene.erosion.max_passes_per_step});
-    if (!ok("erode")) return false;
-    terrain->simplify(SimplifyParams{scene.tin.alpha_flat_deg});
-    return ok("simplify");
+    if (!ok("stamp", tracked)) return false;
+    tracked += terrain->erode(rule, ErosionBudget{scene.erosion.max_passes_per_step}).volume_change_m3;
+    if (!ok("erode", tracked)) return false;
+    tracked += terrain->simplify(SimplifyParams{scene.tin.alpha_flat_deg}).volume_change_m3;
+    return ok("simplify", tracked);
   }
-  bool ok(const char* phase) const {
+  bool ok(const char* phase, double tracked) const {
     const IntegrityReport r = terrain->check();
     EXPECT_TRUE(r.ok()) << "after " << phase << " of stamp " << generation - 1 << ": "
                         << ::testing::PrintToString(r.problems);
-    return r.ok();
+    const double v = terrain->volume();
+    EXPECT_NEAR(tracked, v, 1e-13 * v) << "reported volume change of " << phase << " of stamp " << generation - 1;
+    return r.ok() && std::abs(tracked - v) <= 1e-13 * v;
   }
   ToolStamp at(const ToolSpec& tool, Vec2 xy, double bottom_z, double heading) const {
     ToolPose pose;
@@ -157,10 +162,12 @@ std::pair<std::size_t, std::vector<double>> strokes_to_rest(const std::string& t
     }
     // Settle to rest: the simplification after the last erosion coarsens (and cascades).
     for (int guard = 0; guard < 2000 && run.terrain->stats().active > 0; ++guard) {
-      run.terrain->erode(run.rule, ErosionBudget{64});
-      if (!run.ok("settling erode")) return {removed, slopes};
-      removed += run.terrain->simplify(SimplifyParams{run.scene.tin.alpha_flat_deg}).removed;
-      if (!run.ok("settling simplify")) return {removed, slopes};
+      double tracked = run.terrain->volume() + run.terrain->erode(run.rule, ErosionBudget{64}).volume_change_m3;
+      if (!run.ok("settling erode", tracked)) return {removed, slopes};
+      const SimplifyReport sr = run.terrain->simplify(SimplifyParams{run.scene.tin.alpha_flat_deg});
+      removed += sr.removed;
+      tracked += sr.volume_change_m3;
+      if (!run.ok("settling simplify", tracked)) return {removed, slopes};
       EXPECT_NEAR(run.terrain->volume(), v0, 1e-12 * v0);
     }
     EXPECT_EQ(run.terrain->stats().active, 0u) << "settles";
@@ -261,10 +268,11 @@ path_m = [[0.05, 0.05]]
   // (Measured: 1408 passes. Before the border held like a constraint in split_edge, erosion split
   // edges running almost along the border into chains of slivers against it, and 40000 passes
   // left 504 vertices active, facets at 54 degrees.)
+  double tracked = run.terrain->volume();
   for (int pass = 0; pass < 4000 && run.terrain->stats().active > 0; pass += 64)
-    run.terrain->erode(run.rule, ErosionBudget{.max_passes = 64, .settling = true});
+    tracked += run.terrain->erode(run.rule, ErosionBudget{.max_passes = 64, .settling = true}).volume_change_m3;
   EXPECT_EQ(run.terrain->stats().active, 0u) << "settled";
-  EXPECT_TRUE(run.ok("settling"));
+  EXPECT_TRUE(run.ok("settling", tracked));
   EXPECT_NEAR(run.terrain->volume(), v0, 1e-11 * v0);
 }
 
