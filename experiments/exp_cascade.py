@@ -26,15 +26,11 @@ def cases(profile_name):
     return out
 
 
-def slug(text):
-    return "".join(c if c.isalnum() else "_" for c in text).strip("_")
-
-
 def run(ctx):
     import matplotlib.pyplot as plt
 
     todo = cases(ctx.profile_name)
-    jobs = [(sbrun.SCENES / scene, backend, f"cascade/{slug(case)}-{backend}-{slug(res)}-{on}",
+    jobs = [(sbrun.SCENES / scene, backend, f"cascade/{sbrun.slug(case)}-{backend}-{sbrun.slug(res)}-{on}",
              overrides + [f"erosion.cascade={on}"])
             for case, scene, backend, res, overrides in todo for on in ("true", "false")]
     s = ctx.run_many("cascade", jobs)

@@ -16,14 +16,10 @@ MODELS = [("grid", "grid", []), ("tin", "tin", []),
           ("grid (edge rule)", "grid", [sbrun.PAPER_RULE]), ("tin (edge rule)", "tin", [sbrun.PAPER_RULE])]
 
 
-def slug(text):
-    return "".join(c if c.isalnum() else "_" for c in text).strip("_")
-
-
 def run(ctx):
     import matplotlib.pyplot as plt
 
-    jobs = [(sbrun.SCENES / scene, backend, f"pile_relax/{slug(case)}-{slug(label)}", extra + overrides)
+    jobs = [(sbrun.SCENES / scene, backend, f"pile_relax/{sbrun.slug(case)}-{sbrun.slug(label)}", extra + overrides)
             for case, scene, extra in CASES for label, backend, overrides in MODELS]
     s = ctx.run_many("pile_relax", jobs)
     result = {}

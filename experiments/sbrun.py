@@ -162,6 +162,11 @@ def write_scene(path, text):
     return path
 
 
+def slug(text):
+    """A run-name part from a label: letters and digits kept, everything else '_'."""
+    return "".join(c if c.isalnum() else "_" for c in text).strip("_")
+
+
 def loglog_slope(xs, ys):
     """Least-squares exponent b of y = a x^b over the positive points (nan if fewer than 2)."""
     pts = [(math.log(x), math.log(y)) for x, y in zip(xs, ys) if x > 0 and y > 0]
