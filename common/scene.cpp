@@ -227,6 +227,12 @@ class Fields {
       if (const toml::table* sub = v.as_table()) {
         walk(*sub, key);
       } else if (!seen_.count(key)) {
+        // A key of the format that these settings do not read (tool.profile with a pour tool,
+        // terrain.amplitude_m on flat sand) is a different mistake from a misspelt one.
+        if (!scene_key_meaning(key).empty())
+          fail(key,
+               "does not apply with this scene's terrain.kind, tool.shape or tool.profile (see the scene "
+               "format in README.md)");
         fail(key, "is not a known key (see the scene format in README.md)");
       }
     }

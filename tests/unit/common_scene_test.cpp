@@ -109,6 +109,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{{"tool.radius=0.02"}, "tool.radius", "not a known key"},
         BadField{{"toool.radius_m=0.02"}, "toool.radius_m", "not a known key"},
         BadField{{"tin.cell_m=0.01"}, "tin.cell_m", "not a known key"},
+        // keys of the format that these settings do not read
+        BadField{{"tool.shape=pour", "tool.volume_m3=1e-6", "tool.profile=sphere_cap"},
+                 "tool.profile",
+                 "does not apply with this scene's terrain.kind, tool.shape or tool.profile"},
+        BadField{{"terrain.amplitude_m=0.01"}, "terrain.amplitude_m", "does not apply"},
+        BadField{{"tool.sphere_radius_m=0.05"}, "tool.sphere_radius_m", "does not apply"},
         // inconsistent
         BadField{{"stroke.z_m=[0.1]"}, "stroke.z_m", "one per waypoint"},
         BadField{
