@@ -8,9 +8,10 @@
 //    never sets sand moving, and erosion never refines again what was just coarsened).
 // Border and constrained vertices stay. Redundant vertices are removed by CGAL (Devillers'
 // removal: the star is retriangulated as a constrained Delaunay polygon); the volume change of
-// the retriangulation is measured over the hole and given back to the hole's vertices
-// (tin.conserve_volume, the default), so removal conserves volume. Vertices whose ring is still in L_e rejoin L_r when
-// it settles.
+// the retriangulation is measured over the hole and given back to the hole's vertices where it
+// happened, each taking the removed height over the area it took over (merge_removed_column;
+// tin.conserve_volume, the default), so removal conserves volume and keeps the sand in place.
+// Vertices whose ring is still in L_e rejoin L_r when it settles.
 #include <algorithm>
 #include <cmath>
 
@@ -150,6 +151,32 @@ SimplifyReport TinTerrain::simplify(const SimplifyParams& params) {
   return report;
 }
 
+void TinTerrain::merge_removed_column(const std::vector<VertexHandle>& link, const std::vector<double>& area_before,
+                                      double z_removed, double measured_delta) {
+  // The volume is sum_w z_w A_w exactly (A: a third of the star's area), and only the link's
+  // areas changed: each neighbour w took over dA_w of the removed vertex's area, and takes the
+  // removed height over it, z_w += dA_w (z_removed - z_w) / A_w', which gives back the measured
+  // change up to rounding, where it happened. Spread evenly by area over the link instead, the
+  // change went mostly to the neighbour with the largest star, a domain corner on a coarse mesh:
+  // mass moved across the domain (pile.toml: the pile's centroid 0.8 mm off the pour point).
+  double given = 0.0, largest_gain = 0.0;
+  VertexHandle largest;
+  for (std::size_t k = 0; k < link.size(); ++k) {
+    const VertexHandle w = link[k];
+    if (cdt_.is_infinite(w)) continue;
+    const double area = cached_area(w), gain = area - area_before[k];
+    if (!(area > 0.0)) continue;
+    const double dz = gain * (z_removed - w->point().z()) / area;
+    shift_z(w, w->point().z() + dz, area);
+    given += dz * area;
+    if (gain > largest_gain) largest_gain = gain, largest = w;
+  }
+  // Rounding: what is left goes to the neighbour that took most of the area.
+  const double residual = measured_delta + given;
+  if (residual != 0.0 && largest != VertexHandle())
+    shift_z(largest, largest->point().z() - residual / cached_area(largest), cached_area(largest));
+}
+
 void TinTerrain::simplify_round(double tan_alpha, bool coarsen, bool scan_all, SimplifyReport& report) {
   const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
   const double planar_tol = spec_.planar_tolerance_m > 0.0 ? spec_.planar_tolerance_m : 0.25 * spec_.tolerance_m;
@@ -192,7 +219,7 @@ void TinTerrain::simplify_round(double tan_alpha, bool coarsen, bool scan_all, S
     } while (++c != done);
     const Vec2 p = xy(v);
     // Removing a vertex that is not exactly planar with its star changes the volume:
-    // measured over the hole and spread back over the hole's vertices by area. The capture's
+    // measured over the hole and given back to the hole's vertices (merge_removed_column). The capture's
     // walk starts at v itself (one step; remove_vertex then hands the hint to a neighbour):
     // from wherever the last edit had left the hint, every removal of a rest scan walked across
     // the mesh, O(sqrt(n)) faces each (flat_stroke.toml on 10^6 initial points: ~450 steps a
@@ -202,6 +229,9 @@ void TinTerrain::simplify_round(double tan_alpha, bool coarsen, bool scan_all, S
     const double z_before = v->point().z();
     link_z.clear();
     for (VertexHandle w : link) link_z.push_back(w->point().z());
+    std::vector<double>& link_area = link_area_scratch_;
+    link_area.clear();
+    for (VertexHandle w : link) link_area.push_back(cdt_.is_infinite(w) ? 0.0 : cached_area(w));
     remove_vertex(v);
     if (!coarsen && has_steep_triangle(link, true)) {
       // The paper's step 3 (as before coarsening existed): a triangle of the hole steeper than
@@ -213,12 +243,8 @@ void TinTerrain::simplify_round(double tan_alpha, bool coarsen, bool scan_all, S
     }
     const CaptureResult measured = end_capture(capture);
     volume_change_ += measured.delta();
-    double link_area = 0.0;
-    for (VertexHandle w : link) link_area += cached_area(w);
-    if (spec_.conserve_volume && measured.delta() != 0.0 && link_area > 0.0) {
-      const double dz = -measured.delta() / link_area;
-      for (VertexHandle w : link) shift_z(w, w->point().z() + dz, cached_area(w));
-    }
+    if (spec_.conserve_volume && measured.delta() != 0.0)
+      merge_removed_column(link, link_area, z_before, measured.delta());
     if (coarsen && has_steep_triangle(link, false)) {
       // Coarsening: a triangle of the hole, or one the give-back tilted around it, is steeper
       // than the stable slope (triangles can be steeper than all their edges; a short edge at

@@ -51,8 +51,9 @@
 // Volume: stamps, erosion and simplification conserve volume except where the Delaunay
 // triangulation changes under a non-planar surface (flips after insertions and edge splits,
 // removals of not quite planar vertices, dropped constraints). tin.conserve_volume (the
-// default) measures each such change over the faces it touched and gives it back (to the
-// rim deposit, the split vertex, the hole's vertices): exact to rounding, at the cost of one
+// default) measures each such change over the faces it touched and gives it back there (to
+// the rim deposit, the split vertex, the hole's vertices in proportion to the removed vertex's
+// area each took over): exact to rounding, at the cost of one
 // local face traversal per split and per removal. Either way each phase reports its volume
 // change (volume_change_m3: A dz per height written, plus each retriangulation's measured
 // change), O(1) per edit, so the runner integrates the surface only at a run's start and end.

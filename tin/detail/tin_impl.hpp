@@ -319,6 +319,11 @@ class TinTerrain final : public Terrain {
   // simplify.cpp: one detection (over L_r, or every vertex with scan_all) and removal;
   // `coarsen` allows the planar rule.
   void simplify_round(double tan_alpha, bool coarsen, bool scan_all, SimplifyReport& report);
+  // After removing a vertex at height z_removed: its link (`link`, barycentric areas before the
+  // removal in `area_before`) takes over its area at its height, which gives back the
+  // retriangulation's measured volume change where it happened (simplify.cpp). O(link degree^2).
+  void merge_removed_column(const std::vector<VertexHandle>& link, const std::vector<double>& area_before,
+                            double z_removed, double measured_delta);
   // build.cpp
   void insert_corners(const std::function<double(const Vec2&)>& z);
   void finish_build();
@@ -372,6 +377,7 @@ class TinTerrain final : public Terrain {
   std::vector<VertexHandle> redundant_scratch_;  // simplify: vertices to remove
   std::vector<VertexHandle> link_hold_scratch_;  // simplify: the removed vertex's link
   std::vector<double> link_z_scratch_;           // simplify: the link's heights before the give-back
+  std::vector<double> link_area_scratch_;        // simplify: the link's areas before the removal
   std::vector<VertexHandle> ring_scratch_;       // ring_of: the walk before it is cached
 };
 
