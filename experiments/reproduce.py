@@ -166,9 +166,17 @@ notes); the tables below are this run's.
   CGAL insertion of 2.0-2.7 us each, are about a fifth (346 splits on the pile, 2029 on the trench). So
   the data structure is at most a quarter of a settled visit (**our code**, not pursued: it could not
   bring the pile's step within 3x the grid's); the rest at rest is the rule's scalar arithmetic over an
-  irregular ring (about 700 instructions, against about 40 a node in the grid's eight lanes), which we
-  have not vectorised across a ring (**our code**, open); a stroke's extra cost is the mesh adapting
-  around the tool (splits, stars re-walked after every stamp): **the method**.
+  irregular ring (about 700 instructions, against about 40 a node in the grid's eight lanes). Vectorising
+  that across a ring was tried (**the method**, measured): one ring per AVX-512 vector (rings of 2 to 8
+  neighbours; the fan gradient, the cotangent weights and the excesses in lanes, the ordered sums kept
+  scalar so that every height came out bit for bit as before) took the rule from 41 to 32 ns a call in a
+  stroke and from 50 to 44 ns at rest on random rings (a micro-benchmark), but in the TIN's visits (the
+  ring copied into lanes first, the function compiled for AVX-512 apart from the visit) the steps got
+  slower: pile 1.15x, trench 1.02x, `flat_stroke.toml` 1.02x (medians of 9 interleaved rounds, identical
+  results). A ring of five to seven neighbours fills few lanes, and the rule is one chain of dependent
+  steps (two square roots, five divisions, sums in order) that lanes do not shorten. Not kept. A stroke's
+  extra cost is the mesh adapting around the tool (splits, stars re-walked after every stamp): **the
+  method**.
 - **TIN settling after a deep stroke** (`flat_stroke.toml` with `tool.depth_m = 0.2`): was **our code**,
   fixed. The TIN needed 361k settling updates where the grid needs 97k, because the grid settles with a
   coarse-to-fine cascade and the TIN settled with fine passes only, whose diffusive tail (the last quarter
@@ -207,17 +215,24 @@ notes); the tables below are this run's.
   facet around the vertex (a plane's facets all have its slope; common/erosion.hpp), 54.6 -> 49.8 um,
   flank 29.76 degrees, the relaxed cones 59-69 -> 54-56 um, for a worst single trench section 1.36
   degrees from critical instead of 1.24 and a relaxed plane's steepest facet at 30.9 instead of 30.5
-  degrees; capping by the fan gradient, or during the stroke too, lobed the poured pile (80 and 56 um). Now (the pile-relax table below has this run's
-  figures): RMSE 50 um (1.42x the grid's 35; over eight pour points within two grid cells, the pile
-  positions table below, 37-63 um against the grid's 29-52, 1.29x in the mean: where the sand lands
-  relative to the elements moves either model's error by up to 1.8x), roundness 0.023, with 338 vertices (0.5x the grid's
-  memory), step 4.3-4.8x the grid's (interleaved medians; the machine's load moves it), erosion 94 % of
-  the TIN's stroke time. Where the error was before the cap
-  (share of the squared error): flank 48 %, toe 33 %, apex 6 %, outside the pile 14 % (the grid: 58, 39,
-  4, 0); the flank's 0.5-degree deficit alone accounted for 18 um. Outside the pile, a split's volume
-  give-back lowers the new vertex by up to 0.3 mm, leaving pits below the bed where no tool went; spreading
-  it over the new vertex's star removes most of them but left the RMSE unchanged (56-58 um), so it was not
-  kept. **The method, for the rest**: a piecewise-linear cone on 7 mm edges errs near its apex and toe,
+  degrees; capping by the fan gradient, or during the stroke too, lobed the poured pile (80 and 56 um).
+  Then pits below the bed outside the pile (14 % of the squared error) and sand off the pour point
+  (**our code**, fixed): coarsening at rest gave each removal's volume change back evenly by area over the
+  hole's vertices, so mostly to the one with the largest star, on a coarse bed a domain corner, which
+  moved sand across the domain (after one pour the sand was centred 13.9 mm from the pour point); each
+  hole vertex now takes the removed height over the area it took over (0.7 mm; `tin/simplify.cpp`):
+  49.8 -> 47.6 um, over 16 pour points 48.5 -> 44.2 um in the mean, better at every point, no error left
+  outside the pile. Now (the pile-relax table below has this run's figures): RMSE 48 um (1.36x the grid's
+  35; over eight pour points within two grid cells, the pile positions table below, 31-55 um against the
+  grid's 29-52, 1.20x in the mean: where the sand lands relative to the elements moves either model's
+  error by up to 1.8x), roundness 0.023, with 339 vertices (0.5x the grid's memory), step 4.3-4.8x the
+  grid's (interleaved medians; the machine's load moves it), erosion 94 % of the TIN's stroke time. Where
+  the error is (share of the squared error): flank 57 %, toe 37 %, apex 6 % (the grid: 57, 41, 1). Not
+  in the mesh: the same mesh with its vertices on the exact cone errs 19 um; its heights err 235 um rms
+  on the pile, mostly because the pile stands 0.4 mm off the pour point (its sand's centroid; the cone
+  fitted at the best centre errs 38 um, 1.08x the grid's): the transfers on an irregular mesh move the
+  sand's centroid, pour after pour, also on a jittered lattice (10^4 initial points: 0.5 mm, 40 um, 22 um
+  re-centred). The flank's deficit before the cap accounted for 18 um. **The method, for the rest**: a piecewise-linear cone on 7 mm edges errs near its apex and toe,
   and the accuracy table's TIN points trade step time for it (refined to 4 mm: 55 um at 2.3x the default
   TIN's step; to 2 mm: 51 um at 5.4x; curvature refinement at 0.2 mm: 35 um at 2.1x, where the grids
   reach 33 um at 2 mm and 28 at 1 mm for a fifth to a quarter of that step time; all settled by the fine
@@ -234,10 +249,12 @@ notes); the tables below are this run's.
   whole domain from the start costs memory (0.4-3.8 MB against the grid's 0.16).
   The TIN's own way out, refining only the surface at rest (`tin.curvature_when = "settling"`, "tin curved
   0.2 mm at rest" in the accuracy table): its steps cost what the default TIN's do (the tool's steps are
-  not at rest), and with the drop cap it ends at 41 um (1.16x the grid's) at `tin.curvature_tolerance_m =
-  0.0002`, with 550 vertices, 0.72x the grid's final and 1.12x its peak memory, settling 2x the default
-  TIN's time; at 0.0003-0.001 it ends at 43-48 um (1.24-1.36x; not monotone in the tolerance: 0.0004
-  1.27x, 0.0005 1.24x, 0.0007 1.36x) with peak memory 0.73-0.94x the grid's (single runs of this round).
+  not at rest), and it ends at 37 um (1.05x the grid's) at `tin.curvature_tolerance_m = 0.0002`, with
+  550 vertices, 0.72x the grid's final and 1.12x its peak memory, settling 3.3x the default TIN's time;
+  at 0.0003-0.001 at 40-44 um (1.15-1.25x) with peak memory 0.73-0.94x the grid's (single runs, after
+  the removals' give-back above). As a default it would not pay elsewhere: on the relaxed cone, the
+  trench, the ridge and the plane it changes the error by -0.03 to +0.01 degrees or +-0.5 um, for
+  1.1-5x the settling time (the plane's 0.77 -> 1.54 s, the heightmap's 3-5x) and up to 1.2x the memory.
   That is a choice of accuracy against memory and settling time that the default leaves to the scene, not
   a bar met: whatever the setting, the TIN's step stays 4-5x the grid's, so no TIN setting meets the
   pile's three bars (RMSE <= 1.25x, memory <= 1x, step <= 3x the grid's) at once.
