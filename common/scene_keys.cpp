@@ -52,7 +52,7 @@ std::string scene_key_meaning(const std::string& key) {
       {"stroke.spacing_m", "stamps at this arc-length spacing, first and last included"},
       {"stroke.repeat", "trace the stroke this many times"},
       {"tin.alpha_flat_deg", "simplification threshold"},
-      {"tin.tolerance_m", "max height error of the initial TIN (greedy insertion)"},
+      {"tin.tolerance_m", "max height error of the initial TIN (greedy insertion, then the terrain's L2 projection)"},
       {"tin.conserve_volume", "give back the volume change of every retriangulation; false: the paper's model"},
       {"tin.contour_subdivision_m", "subdivide the tool's outer contour; 0: polygon only"},
       {"tin.snap_m", "points closer than this to a vertex reuse it"},

@@ -239,10 +239,11 @@ void TinTerrain::build_from_field(const HeightField& field) {
     } while (++c != done);
     distribute(faces, pool);
   }
+  if (kind_ != TerrainKind::Plane) project_heights(field);  // a plane is exact already
   finish_build();
 }
 
-void TinTerrain::build_from_points(const std::vector<Vec3>& points) {
+void TinTerrain::build_from_points(const std::vector<Vec3>& points, const HeightField* field) {
   std::vector<Point> pts;
   pts.reserve(points.size());
   for (const Vec3& p : points) {
@@ -265,6 +266,8 @@ void TinTerrain::build_from_points(const std::vector<Vec3>& points) {
     return z;
   });
   cdt_.insert(pts.begin(), pts.end());
+  // A flat bed or a plane is exact already.
+  if (field != nullptr && kind_ != TerrainKind::Flat && kind_ != TerrainKind::Plane) project_heights(*field);
   finish_build();
 }
 
@@ -277,7 +280,9 @@ std::unique_ptr<Terrain> make_tin_terrain(const Scene& scene, const HeightField&
     for (const Vec2& p : jittered_lattice(scene.domain, static_cast<std::size_t>(scene.tin.initial_points),
                                           scene.tin.initial_jitter, static_cast<std::uint64_t>(scene.terrain.seed)))
       points.emplace_back(p.x(), p.y(), initial(p));
-    return make_tin_terrain_from_points(scene, points);
+    auto t = std::make_unique<detail::TinTerrain>(scene);
+    t->build_from_points(points, &initial);
+    return t;
   }
   auto t = std::make_unique<detail::TinTerrain>(scene);
   t->build_from_field(initial);

@@ -79,7 +79,9 @@
 namespace sb::tin {
 
 // The scene's initial surface as a TIN: 2 triangles for a flat terrain, greedy insertion
-// to tin.tolerance_m for dunes and heightmaps. Throws InputError for bad scene values.
+// to tin.tolerance_m for dunes, cones and heightmaps (or tin.initial_points' lattice), whose
+// vertices then take the terrain's L2 projection: the terrain's volume, the least mean-square
+// error on that mesh (tin/project.cpp). Throws InputError for bad scene values.
 std::unique_ptr<Terrain> make_tin_terrain(const Scene& scene, const HeightField& initial);
 
 // A TIN of the given points (inside the scene's domain; duplicates merged) plus the domain's

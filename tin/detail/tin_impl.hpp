@@ -135,8 +135,12 @@ double default_refine_m(const Scene& scene);
 class TinTerrain final : public Terrain {
  public:
   explicit TinTerrain(const Scene& scene);
-  void build_from_field(const HeightField& field);          // build.cpp
-  void build_from_points(const std::vector<Vec3>& points);  // build.cpp
+  void build_from_field(const HeightField& field);  // build.cpp
+  // build.cpp; with `field`, the heights then become its projection (project_heights).
+  void build_from_points(const std::vector<Vec3>& points, const HeightField* field = nullptr);
+  // The vertices' heights become the L2 projection of `field` onto the mesh (project.cpp):
+  // the terrain's volume, a plane exactly. O(faces) plus a few dozen O(vertices) iterations.
+  void project_heights(const HeightField& field);
 
   std::string_view name() const override { return "tin"; }
   double height(const Vec2& p) const override;                                         // mesh_ops.cpp
