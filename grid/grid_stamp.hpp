@@ -6,7 +6,9 @@
 // footprint's boundary or in the rim band; two circles about the footprint decide the
 // other nodes in O(1). Only when the rim band holds no node (narrower than a cell, clipped
 // by the domain) is the window widened, doubling the extra width each time:
-// O(log(domain / cell)) rescans at worst. A pour is O(nodes within the pour radius).
+// O(log(domain / cell)) rescans at worst. A pour lands as a cone of its radius, handed to the
+// nodes by bilinear weights (centred on the pour point between nodes): O((radius / cell)^2 * 16)
+// samples, at most 256^2.
 #include <cstdint>
 #include <vector>
 

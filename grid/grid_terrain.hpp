@@ -28,7 +28,7 @@
 //   height(p)                   O(1)
 //   sample(raster)              O(raster points)
 //   stamp                       O(w), plus O(v) per node near the footprint's boundary
-//                               or in the rim band; pour O(nodes within its radius)
+//                               or in the rim band; pour O((radius / cell)^2) (stamp_kernel.hpp)
 //   erode                       O(passes * a * stencil) on the active set, or per dense
 //                               pass O(nodes between the first and last member of each
 //                               row), the stable ones classed with vector arithmetic;

@@ -141,31 +141,75 @@ StampReport cut_and_push(Store& grid, const ToolStamp& s, std::vector<std::uint3
   return report;
 }
 
+// Where a pour's sand lands: a cone of the pour radius (as on the TIN, tin/stamp.cpp), handed
+// to the nodes by their bilinear weights. A lattice of samples centred on the pour point gives
+// each sample's share of the cone to the four nodes around it; bilinear weights reproduce linear
+// functions, so the sand's centroid lands on the pour point wherever that lies between nodes.
+// (Spread evenly over the nodes within the radius, it landed up to 0.6 mm off on 2.5 mm cells, and
+// pile.toml's error at pour points between nodes came mostly from that: 29-55 um, 29 re-centred.)
+// Samples outside the grid are clamped onto its border. O((radius / spacing)^2) samples, spacing a
+// quarter of the smaller of cell and radius, at most 256 x 256.
+inline std::vector<Deposit> pour_weights(const GridLayout& layout, const Vec2& centre, double radius) {
+  const double cell = std::min(layout.dx, layout.dy);
+  const double r = radius > 0.0 && std::isfinite(radius) ? radius : 0.0;
+  const int half = r > 0.0 ? std::clamp(static_cast<int>(std::ceil(4.0 * r / std::min(cell, r))), 1, 128) : 0;
+  const double spacing = half > 0 ? r / half : 0.0;
+  const Aabb2 box = layout.box();
+  std::vector<Deposit> out;
+  const auto splat = [&](const Vec2& p, double w) {
+    const double fx = (std::clamp(p.x(), box.lo.x(), box.hi.x()) - layout.origin.x()) / layout.dx;
+    const double fy = (std::clamp(p.y(), box.lo.y(), box.hi.y()) - layout.origin.y()) / layout.dy;
+    const double ix = std::clamp(std::floor(fx), 0.0, static_cast<double>(layout.nx - 2));
+    const double iy = std::clamp(std::floor(fy), 0.0, static_cast<double>(layout.ny - 2));
+    const double tx = fx - ix, ty = fy - iy;
+    const auto k = layout.index(static_cast<std::size_t>(ix), static_cast<std::size_t>(iy));
+    const auto nx = static_cast<std::uint32_t>(layout.nx);
+    out.push_back({k, w * (1.0 - tx) * (1.0 - ty)});
+    out.push_back({k + 1, w * tx * (1.0 - ty)});
+    out.push_back({k + nx, w * (1.0 - tx) * ty});
+    out.push_back({k + nx + 1, w * tx * ty});
+  };
+  for (int i = -half; i < half; ++i)
+    for (int j = -half; j < half; ++j) {
+      const Vec2 offset((i + 0.5) * spacing, (j + 0.5) * spacing);
+      const double w = 1.0 - offset.norm() / r;
+      if (w > 0.0) splat(centre + offset, w);
+    }
+  if (out.empty()) splat(centre, 1.0);  // a point pour, or one narrower than the samples
+  // One entry per node, in node order.
+  std::sort(out.begin(), out.end(), [](const Deposit& a, const Deposit& b) { return a.node < b.node; });
+  std::size_t kept = 0;
+  for (const Deposit& d : out) {
+    if (kept > 0 && out[kept - 1].node == d.node)
+      out[kept - 1].weight += d.weight;
+    else
+      out[kept++] = d;
+  }
+  out.resize(kept);
+  return out;
+}
+
 template <class Store>
 StampReport pour(Store& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed) {
   const GridLayout& layout = grid.layout();
   if (!s.pose.xy.allFinite() || !std::isfinite(s.pour_volume_m3)) return {};
-  std::vector<std::uint32_t> nodes;
-  const NodeRange r = layout.nodes_in(s.influence_bounds());
-  const double r2 = s.pour_radius_m * s.pour_radius_m;
-  for (std::size_t iy = r.y0; !r.empty && iy <= r.y1; ++iy)
-    for (std::size_t ix = r.x0; ix <= r.x1; ++ix)
-      if ((layout.position(ix, iy) - s.pose.xy).squaredNorm() <= r2) nodes.push_back(layout.index(ix, iy));
-  // A pour narrower than a cell (or off the grid) still lands somewhere.
-  if (nodes.empty()) nodes.push_back(layout.nearest(s.pose.xy));
-
-  CompensatedSum area;
-  for (std::uint32_t k : nodes) area.add(layout.area(k));
-  const double dz = s.pour_volume_m3 / area.value();
+  const std::vector<Deposit> nodes = pour_weights(layout, s.pose.xy, s.pour_radius_m);
+  CompensatedSum total;
+  for (const Deposit& d : nodes) total.add(d.weight);
   CompensatedSum deposited;
-  for (std::uint32_t k : nodes) {
-    grid.set(k, grid.z(k) + dz);
-    deposited.add(layout.area(k) * dz);
-    changed.push_back(k);
+  std::size_t touched = 0;
+  for (const Deposit& d : nodes) {
+    if (!(d.weight > 0.0)) continue;
+    ++touched;
+    const double area = layout.area(d.node);
+    const double dz = s.pour_volume_m3 * (d.weight / total.value()) / area;
+    grid.set(d.node, grid.z(d.node) + dz);
+    deposited.add(area * dz);
+    changed.push_back(d.node);
   }
   StampReport report;
   report.volume_deposited_m3 = deposited.value();
-  report.elements_touched = nodes.size();
+  report.elements_touched = touched;
   return report;
 }
 
