@@ -45,9 +45,11 @@ class GridTerrainBase : public Terrain {
   void sample(Raster& out) const override { grid_sample(heights_, out); }
   double max_slope_deg() const override { return grid_max_slope_deg(heights_, stencil_); }
 
-  // For tests and benchmarks: every node a member of the active set; which sweep erosion
-  // runs (default Auto: the dense pass when the members fill an eighth of their row spans).
+  // For tests and benchmarks: every node a member of the active set, or node (ix, iy) and its
+  // 3 x 3 block (as a stamp activates the nodes it changed); which sweep erosion runs
+  // (default Auto: the dense pass when the members fill an eighth of their row spans).
   void activate_all() { active_.activate_all(); }
+  void activate_block(std::size_t ix, std::size_t iy) { active_.activate_block(ix, iy); }
   void set_sweep_path(SweepPath path) { sweep_path_ = path; }
   // Whether large settling budgets start with the multi-resolution cascade (default on;
   // multires_settle.hpp).
