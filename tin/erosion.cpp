@@ -86,12 +86,14 @@ VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* insert
     *inserted = false;
     return a;
   }
-  // A middle closer to the domain's border than a crowded split goes onto it. Edges at a shallow
-  // angle to the border (a narrow domain's first diagonal: 1.9 degrees on a 0.3 x 0.01 m strip),
-  // halved again and again, put vertices microns from it, the apices of slivers along it whose
-  // near-zero areas throttled every transfer: a pile poured on that strip never settled (facets
-  // at 88 degrees after 20000 passes, 127 M updates) where the grid settles at once.
-  const double near = kCrowdedSplit * refine_m_;
+  // A middle a hair from the domain's border (closer than kBesideConstraint of the edge's length,
+  // as beside a constraint) goes onto it. Edges at a shallow angle to the border (a narrow
+  // domain's first diagonal: 1.9 degrees on a 0.3 x 0.01 m strip), halved again and again, put
+  // vertices microns from it, the apices of slivers along it whose near-zero areas throttled every
+  // transfer: a pile poured on that strip never settled (facets at 88 degrees after 20000
+  // passes, 127 M updates) where the grid settles at once. (Snapping every middle within a crowded
+  // split of the border instead unsettled other narrow domains, whose interiors it kept coarse.)
+  const double near = std::min(kCrowdedSplit * refine_m_, kBesideConstraint * (xy(a) - xy(b)).norm());
   for (int axis = 0; axis < 2; ++axis) {
     if (m[axis] - box_.lo[axis] < near) m[axis] = box_.lo[axis];
     if (box_.hi[axis] - m[axis] < near) m[axis] = box_.hi[axis];
