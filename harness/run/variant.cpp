@@ -56,6 +56,18 @@ Variant parse_variant(const std::string& text, const std::string& option) {
   return v;
 }
 
+std::string build_notice(const std::string& backend, const Scene& scene) {
+  // Measured on flat_stroke.toml (build, sampling and run file of a one-stamp run): 10^6 points
+  // 2.7 s and 352 MB, 4 x 10^6 points 10.6 s and 1.16 GB.
+  constexpr double kLargeTin = 2e6, kSecondsPerPoint = 2.7e-6, kBytesPerPoint = 290.0;
+  const auto n = static_cast<double>(scene.tin.initial_points);
+  if (backend != "tin" || n < kLargeTin) return {};
+  char text[160];
+  std::snprintf(text, sizeof text, "building a TIN of %lld initial points: about %.0f s and %.1f GB",
+                static_cast<long long>(scene.tin.initial_points), n * kSecondsPerPoint, n * kBytesPerPoint / 1e9);
+  return text;
+}
+
 VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_progress) {
   std::vector<std::string> overrides = base.scene.overrides;
   overrides.insert(overrides.end(), v.overrides.begin(), v.overrides.end());
@@ -68,6 +80,8 @@ VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_pr
   prepared.scene = scene;
   prepared.rule = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg, scene.erosion.rule);
 
+  if (const std::string notice = build_notice(v.backend, prepared.scene); !notice.empty())
+    std::fprintf(stderr, "[%s] %s\n", v.label.c_str(), notice.c_str());
   auto terrain = make_terrain(v.backend, prepared.scene, prepared.initial);
   RunCallbacks callbacks;
   callbacks.notice = [label = v.label](const std::string& message) {

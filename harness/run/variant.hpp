@@ -33,6 +33,10 @@ struct VariantRun {
 };
 VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_progress);
 
+// What run_variant says on stderr before building a model that takes long to build (a TIN of
+// at least 2e6 tin.initial_points: its estimated time and memory), or "" when it is quick.
+std::string build_notice(const std::string& backend, const Scene& scene);
+
 // The scene overrides of --unset KEY ... then --set KEY=VALUE ... (removals first, so that
 // `--unset tool.radius_m --set tool.shape=box --set tool.size_m=[0.04,0.02]` switches a tool).
 std::vector<std::string> scene_overrides(const std::vector<std::string>& unset, const std::vector<std::string>& set);

@@ -20,6 +20,7 @@
 #include "common/scene.hpp"
 #include "harness/io/run_file.hpp"
 #include "harness/io/session_file.hpp"
+#include "harness/run/variant.hpp"
 #include "harness_test_support.hpp"
 
 namespace {
@@ -415,6 +416,19 @@ TEST_F(Outputs, UtmOffsetTinSurvivesPlyExactlyAndTheCrsReachesTheSidecar) {
   const CliResult g = sandbench("export " + run.string() + " --format png16 -o " + (dir_ / "utm.png").string());
   ASSERT_EQ(g.code, 0) << g.out;
   EXPECT_TRUE(contains(slurp(dir_ / "utm.png.aux.xml"), "<SRS>EPSG:32633</SRS>"));
+}
+
+// A TIN of millions of initial points takes long to build, before any stamp: the run says so
+// when it starts, with the time and memory to expect; smaller models say nothing.
+TEST(BuildNotice, ALargeTinBuildSaysSoWhenItStarts) {
+  const std::string text = "[domain]\nsize_m = [1.0, 1.0]\n[stroke]\npath_m = [[0.5, 0.5]]\n";
+  const sb::Scene large = sb::parse_scene(text, "test", {"tin.initial_points=4000000"});
+  const std::string notice = sb::build_notice("tin", large);
+  EXPECT_NE(notice.find("4000000 initial points"), std::string::npos) << notice;
+  EXPECT_NE(notice.find("about 11 s and 1.2 GB"), std::string::npos) << notice;
+  EXPECT_EQ(sb::build_notice("grid", large), "");
+  EXPECT_EQ(sb::build_notice("tin", sb::parse_scene(text, "test", {"tin.initial_points=1000000"})), "");
+  EXPECT_EQ(sb::build_notice("tin", sb::parse_scene(text, "test")), "");
 }
 
 }  // namespace
