@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "common/bilinear.hpp"
 #include "common/terrain.hpp"
 #include "grid/compensated_sum.hpp"
 #include "grid/grid_layout.hpp"
@@ -147,27 +148,21 @@ StampReport cut_and_push(Store& grid, const ToolStamp& s, std::vector<std::uint3
 // functions, so the sand's centroid lands on the pour point wherever that lies between nodes.
 // (Spread evenly over the nodes within the radius, it landed up to 0.6 mm off on 2.5 mm cells, and
 // pile.toml's error at pour points between nodes came mostly from that: 29-55 um, 29 re-centred.)
-// Samples outside the grid are clamped onto its border. O((radius / spacing)^2) samples, spacing a
-// quarter of the smaller of cell and radius, at most 256 x 256.
+// Samples outside the grid are clamped onto its border (bilinear_cell, common/bilinear.hpp). O((radius / spacing)^2)
+// samples, spacing a quarter of the smaller of cell and radius, at most 256 x 256.
 inline std::vector<Deposit> pour_weights(const GridLayout& layout, const Vec2& centre, double radius) {
   const double cell = std::min(layout.dx, layout.dy);
   const double r = radius > 0.0 && std::isfinite(radius) ? radius : 0.0;
   const int half = r > 0.0 ? std::clamp(static_cast<int>(std::ceil(4.0 * r / std::min(cell, r))), 1, 128) : 0;
   const double spacing = half > 0 ? r / half : 0.0;
-  const Aabb2 box = layout.box();
   std::vector<Deposit> out;
   const auto splat = [&](const Vec2& p, double w) {
-    const double fx = (std::clamp(p.x(), box.lo.x(), box.hi.x()) - layout.origin.x()) / layout.dx;
-    const double fy = (std::clamp(p.y(), box.lo.y(), box.hi.y()) - layout.origin.y()) / layout.dy;
-    const double ix = std::clamp(std::floor(fx), 0.0, static_cast<double>(layout.nx - 2));
-    const double iy = std::clamp(std::floor(fy), 0.0, static_cast<double>(layout.ny - 2));
-    const double tx = fx - ix, ty = fy - iy;
-    const auto k = layout.index(static_cast<std::size_t>(ix), static_cast<std::size_t>(iy));
-    const auto nx = static_cast<std::uint32_t>(layout.nx);
-    out.push_back({k, w * (1.0 - tx) * (1.0 - ty)});
-    out.push_back({k + 1, w * tx * (1.0 - ty)});
-    out.push_back({k + nx, w * (1.0 - tx) * ty});
-    out.push_back({k + nx + 1, w * tx * ty});
+    const Vec2 g = (p - layout.origin).cwiseQuotient(Vec2(layout.dx, layout.dy));
+    const BilinearCell c = bilinear_cell(g.x(), g.y(), layout.nx, layout.ny);
+    out.push_back({layout.index(c.ix, c.iy), w * (1.0 - c.tx) * (1.0 - c.ty)});
+    out.push_back({layout.index(c.ix1, c.iy), w * c.tx * (1.0 - c.ty)});
+    out.push_back({layout.index(c.ix, c.iy1), w * (1.0 - c.tx) * c.ty});
+    out.push_back({layout.index(c.ix1, c.iy1), w * c.tx * c.ty});
   };
   for (int i = -half; i < half; ++i)
     for (int j = -half; j < half; ++j) {

@@ -42,19 +42,20 @@ struct QuadraturePoint {
 constexpr std::array<QuadraturePoint, 3> kRule{{{2.0 / 3.0, 1.0 / 6.0, 1.0 / 6.0, 1.0 / 3.0},
                                                 {1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0, 1.0 / 3.0},
                                                 {1.0 / 6.0, 1.0 / 6.0, 2.0 / 3.0, 1.0 / 3.0}}};
+// At most this many pieces along a triangle's side for the quadrature (64^2 pieces).
+constexpr int kMaxPieces = 64;
 // The residual's norm relative to b's: the volume error is the residual's sum. Measured
 // iterations from 36 vertices (cone.toml) to 10^6 (dunes on initial points): 16 to 23.
 constexpr double kTolerance = 1e-14;
-// At most this many pieces along a triangle's side for the quadrature (64^2 pieces).
-constexpr int kMaxPieces = 64;
 constexpr int kMaxIterations = 200;
 
 }  // namespace
 
 void TinTerrain::project_heights(const HeightField& field) {
   // Vertex indices in the vertices' marks (finish_build resets them); the faces as index
-  // triples with their areas: the mass matrix is applied face by face, never stored (stored,
-  // with its assembly, it took 0.5 GB for 10^6 vertices).
+  // triples with their areas: the mass matrix is applied face by face, never stored (stored as
+  // an Eigen sparse matrix for Eigen's conjugate gradients, with its assembly, it took 0.5 GB
+  // for 10^6 vertices; the few lines of preconditioned CG below need none of it).
   std::vector<VertexHandle> vertices;
   vertices.reserve(cdt_.number_of_vertices());
   for (auto v = cdt_.finite_vertices_begin(); v != cdt_.finite_vertices_end(); ++v) {

@@ -227,11 +227,13 @@ void TinTerrain::simplify_round(double tan_alpha, bool coarsen, bool scan_all, S
     edit_walk_.hint = v;
     Capture capture = begin_capture(Aabb2{p, p}.expanded(4.0 * spec_.snap_m + 1e-9 * extent));
     const double z_before = v->point().z();
-    link_z.clear();
-    for (VertexHandle w : link) link_z.push_back(w->point().z());
     std::vector<double>& link_area = link_area_scratch_;
+    link_z.clear();
     link_area.clear();
-    for (VertexHandle w : link) link_area.push_back(cdt_.is_infinite(w) ? 0.0 : cached_area(w));
+    for (VertexHandle w : link) {
+      link_z.push_back(w->point().z());
+      link_area.push_back(cdt_.is_infinite(w) ? 0.0 : cached_area(w));
+    }
     remove_vertex(v);
     if (!coarsen && has_steep_triangle(link, true)) {
       // The paper's step 3 (as before coarsening existed): a triangle of the hole steeper than
