@@ -462,6 +462,7 @@ void read_scene(Fields& f, Scene& s, const std::filesystem::path& base_dir) {
   s.grid.neighbours = static_cast<int>(f.integer("grid.neighbours", 8, 4, 8));
   if (s.grid.neighbours != 4 && s.grid.neighbours != 8)
     Fields::fail("grid.neighbours", "= " + std::to_string(s.grid.neighbours) + " is not allowed; must be 4 or 8");
+  s.grid.threads = static_cast<int>(f.integer("grid.threads", 1, 1, 2));
 
   // [reference]
   const std::string reference =

@@ -94,6 +94,8 @@ struct GridSpec {
   double cell_m = 0.005;
   GridStorage storage = GridStorage::Double;
   int neighbours = 8;  // 4 or 8
+  // Threads a large dense erosion pass may use (1 or 2): time only, the heights are the same.
+  int threads = 1;
 };
 
 // The analytic shape the run is measured against (common/reference.hpp).

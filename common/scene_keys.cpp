@@ -73,6 +73,7 @@ std::string scene_key_meaning(const std::string& key) {
       {"grid.cell_m", "node spacing"},
       {"grid.storage", "height storage type"},
       {"grid.neighbours", "erosion stencil (4 or 8)"},
+      {"grid.threads", "threads a large dense erosion pass may use (1 or 2); the heights do not depend on it"},
       {"output.raster_m", "spacing of the comparison raster (default: min(0.0025, extent/100))"},
       {"output.energy", "record the potential energy after each step"},
       {"reference.kind", "analytic reference for the accuracy metrics"},

@@ -330,7 +330,14 @@ notes); the tables below are this run's.
   inlined into the row loop): on `grid_bench`'s states 102-104 M updates/s on the pile and 158-160 M on
   the stroke (36-51 five rounds ago, 82 and 126 at the start of the last round), 194-197 M with every node of 2048^2
   active (162 then), 12.5x a plain scalar sweep of the same rule (interleaved medians, +-5 %
-  between runs). That meets the 100 M on the pile, not the 250 M all active. Tried and measured, not
+  between runs). On one core that meets the 100 M on the pile, not the 250 M all active. A large dense
+  pass (2^16 nodes in 32 rows or more) now runs as two bands of rows and the two-row seam between them
+  (rows three apart touch disjoint rows, so the bands may run at once; the seam goes after, and the
+  heights are the same bit for bit on one thread or two): with `grid.threads = 2` (`grid_bench`'s
+  `BM_AllActiveTwoThreads`, double) 341-349 M updates/s of wall time with every node of 2048^2 active,
+  1.8x one thread's 193 and 22x the scalar sweep, for the same CPU time (87 ms for 4 passes either
+  way). The comparison runs `grid.threads = 1`, so that the grid is timed on one core as the TIN is;
+  float runs its bands one after the other (its rounding carry chains the writes). Tried and measured, not
   kept (ratios pile / stroke / all active): keeping a chunk of a row in registers across its three
   column phases, which saves the permutes that gather a 3 x 3 block per lane but makes each chunk wait
   for the one before (0.94 / 0.92 / 0.67); splitting the rows by column modulo 3 once per row (0.93 /

@@ -100,7 +100,9 @@
 // dense_pass_avx512; two cores shared with other jobs, so figures move by ~5 % between runs),
 // M updates/s (an update: one node of a span or one active-set visit), now (before): double 102
 // on the pile (101), 158 on the stroke (156), 194 with every node of 2048^2 active (196; 12.5x
-// the plain scalar sweep's 15.5 in the same runs); float 51 (49), 70 (67), 99 (95); the
+// the plain scalar sweep's 15.5 in the same runs) on one thread, 341-349 of wall time on two
+// (dense_pass's bands at once; 1.8x one thread's 193 in the same runs, the same CPU time, 22x
+// the scalar sweep); float 51 (49), 70 (67), 99 (95); the
 // gradient rule (AVX-512 lanes only; AVX2 visits it one node at a time), double: 70 on the pile
 // and 101 on the stroke (66, 97). Measured in the AVX2 lanes (callgrind, which runs no AVX-512;
 // the instructions of erode_ordered per update, unchanged by that build), double / float:
@@ -129,7 +131,9 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <exception>
 #include <limits>
+#include <thread>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -516,6 +520,26 @@ struct WindowOfStore<Store> {
 template <class Store>
 using WindowOf = typename WindowOfStore<Store>::type;
 
+// A run of rows of a dense pass (dense_rows): from `first` in the pass's y direction, either
+// `rows` rows (a band, which stops there) or, with rows = 0, on to the spans' end and past it
+// while the row before transferred. live_lo..live_hi: the transfers of the row visited just
+// before `first` (empty: lo > hi); moved: the volume moved so far, to add this run's to.
+struct DenseRun {
+  std::size_t first = 0, rows = 0;
+  bool y_up = true, x_up = true;
+  std::size_t live_lo = 1, live_hi = 0;
+  double moved = 0.0;
+};
+// What a run did: the nodes that transferred (one row of words per visited row, in visiting
+// order), its counts, the columns it visited, and its last row's transfers (for the next run).
+struct DenseRunResult {
+  std::vector<std::uint64_t> moved_bits;
+  std::size_t rows = 0, updates = 0, transfers = 0;
+  double moved = 0.0;
+  std::size_t col_lo = 0, col_hi = 0;
+  std::size_t live_lo = 1, live_hi = 0;
+};
+
 // One dense pass, in place (Gauss-Seidel), rows in the direction the active set's next
 // sweep would take: in each row, every node from the first to the last member (the row's
 // span) is visited once. Like the active-set sweep it is live: a row's span also covers the
@@ -557,16 +581,15 @@ using WindowOf = typename WindowOfStore<Store>::type;
 // Cost: O(span nodes) per pass -- the classing vectorised over the row, one visit per
 // unstable node -- plus O(words of the visited rows) to find the spans and update the set.
 template <int N, bool Gradient, Lanes lanes, class Store, class Active>
-inline void dense_pass_rows(Store& store, Active& active, const typename Active::Spans& spans, const ErosionTables& t,
-                            ErosionReport& report, double& moved) {
+inline void dense_rows(Store& store, const Active& active, const typename Active::Spans& spans, const ErosionTables& t,
+                       const DenseRun& run, DenseRunResult& out) {
   const std::size_t nx = t.layout().nx, ny = t.layout().ny;
-  const unsigned pass = active.next_sweep();
-  const bool y_up = pass % 2 == 0;
-  const bool x_up = (pass / 2) % 2 == 0;
+  const bool y_up = run.y_up, x_up = run.x_up;
   const std::size_t words = active.words_per_row();
   // The nodes that transferred, one row of words per visited row in visiting order.
-  std::vector<std::uint64_t> moved_bits;
-  moved_bits.reserve((spans.y1 - spans.y0 + 3) * words);  // the members' rows and one each way, as a rule
+  std::vector<std::uint64_t>& moved_bits = out.moved_bits;
+  moved_bits.clear();
+  moved_bits.reserve((run.rows > 0 ? run.rows : spans.y1 - spans.y0 + 3) * words);  // and one row each way, as a rule
   // A store without contiguous heights that copies rows (the sparse grid) runs each row on a
   // RowWindow of the three rows it touches (node k = nx + ix of the row), as a contiguous
   // store runs it on its own heights (node k = iy * nx + ix). The window slides from row to
@@ -589,18 +612,17 @@ inline void dense_pass_rows(Store& store, Active& active, const typename Active:
   // nodes out of its visits, the next row is visited whole (every node flagged: the same heights
   // bit for bit, as above). Rows are alike from one to the next on the states this pass is for.
   bool class_row = true;
-  std::size_t prev_lo = 1, prev_hi = 0;  // span of the previous row's transfers (empty)
+  std::size_t prev_lo = run.live_lo, prev_hi = run.live_hi;  // span of the previous row's transfers
   std::size_t visited_rows = 0;
-  double moved_sum = moved;  // in visiting order, in a register
-  std::size_t transfer_count = 0;
+  double moved_sum = run.moved;  // in visiting order, in a register
+  std::size_t transfer_count = 0, updates = 0;
   std::size_t col_lo = nx, col_hi = 0;  // columns of the visited spans: every member and transfer lies in them
-  const std::size_t first = y_up ? spans.y0 : spans.y1;
-  for (std::size_t iy = first; iy < ny; iy = y_up ? iy + 1 : iy - 1) {  // iy - 1 wraps below 0: stops
+  for (std::size_t iy = run.first; iy < ny; iy = y_up ? iy + 1 : iy - 1) {  // iy - 1 wraps below 0: stops
     std::size_t x0 = nx, x1 = 0;
     const bool members = active.row_span(iy, x0, x1);
     const bool live = prev_lo <= prev_hi;
     const bool inside = y_up ? iy <= spans.y1 : iy >= spans.y0;
-    if (!members && !live && !inside) break;
+    if (run.rows > 0 ? visited_rows == run.rows : !members && !live && !inside) break;
     if (live) {  // the blocks of the previous row's transfers
       x0 = std::min(x0, prev_lo > 0 ? prev_lo - 1 : 0);
       x1 = std::max(x1, std::min(prev_hi + 1, nx - 1));
@@ -760,7 +782,7 @@ inline void dense_pass_rows(Store& store, Active& active, const typename Active:
         visit(x0);
       }
     }
-    report.updates += x1 - x0 + 1;
+    updates += x1 - x0 + 1;
     col_lo = std::min(col_lo, x0), col_hi = std::max(col_hi, x1);
     if (row_lo <= row_hi) prev_lo = row_lo, prev_hi = row_hi;
     // Class the next row where the classing pays (see class_row): this one left more than an
@@ -770,40 +792,141 @@ inline void dense_pass_rows(Store& store, Active& active, const typename Active:
     class_row = (classed ? span - std::min(covered, span) : idle) * 8 > span;
   }
   if constexpr (kWindowed) window.flush();  // the rows still held, back into the store
-  // Rows in increasing y for the set.
-  const std::size_t last = y_up ? first + visited_rows - 1 : first - (visited_rows - 1);
-  if (!y_up)
-    for (std::size_t a = 0, b = visited_rows - 1; a < b; ++a, --b)
-      std::swap_ranges(moved_bits.begin() + static_cast<std::ptrdiff_t>(a * words),
-                       moved_bits.begin() + static_cast<std::ptrdiff_t>((a + 1) * words),
-                       moved_bits.begin() + static_cast<std::ptrdiff_t>(b * words));
-  active.assign_blocks(moved_bits, std::min(first, last), std::max(first, last), col_lo, col_hi);
-  moved = moved_sum;
-  report.transfers += transfer_count;
+  out.rows = visited_rows;
+  out.updates = updates;
+  out.transfers = transfer_count;
+  out.moved = moved_sum;
+  out.col_lo = col_lo, out.col_hi = col_hi;
+  out.live_lo = prev_lo, out.live_hi = prev_hi;
 }
 
-// dense_pass_rows in AVX-512 lanes, compiled for AVX-512 as a whole (flatten): the eight-node
-// visits, the classing and the set's update are inlined into the row loop, not called (measured
-// before / after in this file's header). fp-contract=off as in erosion_lanes_avx512.hpp: the
-// scalar visits inlined here must not be fused into multiply-adds (AVX-512 has them), so every
-// path still computes the same heights bit for bit (tests/unit/grid_dense_pass_test.cpp).
+// dense_rows in AVX-512 lanes, compiled for AVX-512 as a whole (flatten): the eight-node
+// visits and the classing are inlined into the row loop, not called (measured before / after
+// in this file's header). fp-contract=off as in erosion_lanes_avx512.hpp: the scalar visits
+// inlined here must not be fused into multiply-adds (AVX-512 has them), so every path still
+// computes the same heights bit for bit (tests/unit/grid_dense_pass_test.cpp).
 template <int N, bool Gradient, class Store, class Active>
 [[gnu::target("avx512f,avx512vl,avx512dq,avx512bw"), gnu::optimize("fp-contract=off"), gnu::flatten]] void
-dense_pass_avx512(Store& store, Active& active, const typename Active::Spans& spans, const ErosionTables& t,
-                  ErosionReport& report, double& moved) {
-  dense_pass_rows<N, Gradient, Lanes::Avx512>(store, active, spans, t, report, moved);
+dense_rows_avx512(Store& store, const Active& active, const typename Active::Spans& spans, const ErosionTables& t,
+                  const DenseRun& run, DenseRunResult& out) {
+  dense_rows<N, Gradient, Lanes::Avx512>(store, active, spans, t, run, out);
 }
 
-// One dense pass (dense_pass_rows) in the given lanes.
+// One run of rows (dense_rows) in the given lanes.
+template <int N, bool Gradient, class Store, class Active>
+void dense_rows_in(Lanes lanes, Store& store, const Active& active, const typename Active::Spans& spans,
+                   const ErosionTables& t, const DenseRun& run, DenseRunResult& out) {
+  if (lanes == Lanes::Avx512)
+    dense_rows_avx512<N, Gradient>(store, active, spans, t, run, out);
+  else if (lanes == Lanes::Avx2)
+    dense_rows<N, Gradient, Lanes::Avx2>(store, active, spans, t, run, out);
+  else
+    dense_rows<N, Gradient, Lanes::Sse2>(store, active, spans, t, run, out);
+}
+
+// Whether a dense pass over these spans is split into two bands and a seam (dense_pass): tall
+// and large enough that a second thread pays for its start (~50 us against ~0.3 ms of visits).
+// A property of the spans alone, so every store and thread count takes the same order.
+template <class Spans>
+bool dense_pass_splits(const Spans& spans) {
+  return spans.y1 - spans.y0 + 1 >= 32 && spans.nodes >= std::size_t{1} << 16;
+}
+
+// Whether a store's bands may run at the same time: heights in one array that is written in
+// place (HeightGrid) and no rounding carry (double): the carry chains every write to the one
+// before (height_grid.hpp), and a sparse store's accessors and row windows are not shared.
+template <class Store>
+constexpr bool bands_run_together() {
+  return !Store::kRounds && requires(Store & s) { s.data(); }
+  &&!requires(Store & s) { s.read_row(0, 0, 0, nullptr); };
+}
+
+// One dense pass (dense_rows) in the given lanes, then the active set updated word by word
+// (assign_blocks). Large passes (dense_pass_splits) go in a fixed order of three runs: the
+// first band (the first half of the spans' rows in the sweep's direction, up to two rows
+// before the middle), the second band (from two rows after, to the end and on while live),
+// then the seam between them (two rows, live from the first band's last row). A row's visits
+// touch only it and its two neighbours, so the two bands touch disjoint rows and either order
+// of them gives the same heights: on `threads` >= 2 (and a store whose bands run together) the
+// second band runs on a thread of its own while the first runs on this one. The order is a
+// sequential one, so the conservation and energy arguments above hold as they are, and the
+// heights are the same bit for bit with one thread or two, dense or sparse. It differs from a
+// pass that is not split only at the seam: the second band starts without the first's live
+// rows (its first row's span is its members'), and sand that crosses the seam downstream is
+// taken on by the next pass. Cost of the split: the seam's two rows visited after the bands,
+// a thread started per pass, and the bits copied once into rows of increasing y.
 template <int N, bool Gradient, class Store, class Active>
 void dense_pass(Store& store, Active& active, const typename Active::Spans& spans, const ErosionTables& t,
-                ErosionReport& report, double& moved, Lanes lanes) {
-  if (lanes == Lanes::Avx512)
-    dense_pass_avx512<N, Gradient>(store, active, spans, t, report, moved);
-  else if (lanes == Lanes::Avx2)
-    dense_pass_rows<N, Gradient, Lanes::Avx2>(store, active, spans, t, report, moved);
-  else
-    dense_pass_rows<N, Gradient, Lanes::Sse2>(store, active, spans, t, report, moved);
+                ErosionReport& report, double& moved, Lanes lanes, unsigned threads = 1) {
+  const unsigned pass = active.next_sweep();
+  DenseRun run{.first = 0, .rows = 0, .y_up = pass % 2 == 0, .x_up = (pass / 2) % 2 == 0, .moved = moved};
+  const bool y_up = run.y_up;
+  run.first = y_up ? spans.y0 : spans.y1;
+  const auto row_at = [&](std::size_t first, std::size_t i) { return y_up ? first + i : first - i; };
+  const auto go = [&](const DenseRun& r, DenseRunResult& out) {
+    dense_rows_in<N, Gradient>(lanes, store, std::as_const(active), spans, t, r, out);
+  };
+  // The runs in the order of their rows (first band, seam, second band), and the one run last.
+  DenseRunResult parts[3];
+  std::size_t count = 1, last_run = 0;
+  if (!dense_pass_splits(spans)) {
+    go(run, parts[0]);
+  } else {
+    count = 3, last_run = 1;
+    const std::size_t band_rows = (spans.y1 - spans.y0 + 1 - 2) / 2;
+    DenseRun first_band = run, second_band = run, seam = run;
+    first_band.rows = band_rows;
+    second_band.first = row_at(run.first, band_rows + 2);
+    second_band.moved = 0.0;
+    if (bands_run_together<Store>() && threads >= 2) {
+      std::exception_ptr failed;
+      std::thread other([&] {
+        try {
+          go(second_band, parts[2]);
+        } catch (...) {
+          failed = std::current_exception();
+        }
+      });
+      go(first_band, parts[0]);
+      other.join();
+      if (failed) std::rethrow_exception(failed);
+    } else {
+      go(first_band, parts[0]);
+      go(second_band, parts[2]);
+    }
+    seam.first = row_at(run.first, band_rows);
+    seam.rows = 2;
+    seam.live_lo = parts[0].live_lo, seam.live_hi = parts[0].live_hi;
+    seam.moved = parts[0].moved + parts[2].moved;
+    go(seam, parts[1]);
+  }
+  // The rows the runs visited, in increasing y for the set (they adjoin, in visiting order).
+  const std::size_t words = active.words_per_row();
+  std::size_t rows = 0, col_lo = t.layout().nx, col_hi = 0;
+  for (std::size_t r = 0; r < count; ++r) {
+    rows += parts[r].rows;
+    report.updates += parts[r].updates;
+    report.transfers += parts[r].transfers;
+    col_lo = std::min(col_lo, parts[r].col_lo), col_hi = std::max(col_hi, parts[r].col_hi);
+  }
+  moved = parts[last_run].moved;
+  const std::size_t last = row_at(run.first, rows - 1), y_min = std::min(run.first, last);
+  std::vector<std::uint64_t> bits;
+  if (count == 1) {  // one run: its rows, reversed in place when the pass went down
+    bits = std::move(parts[0].moved_bits);
+    if (!y_up)
+      for (std::size_t a = 0, b = rows - 1; a < b; ++a, --b)
+        std::swap_ranges(bits.begin() + static_cast<std::ptrdiff_t>(a * words),
+                         bits.begin() + static_cast<std::ptrdiff_t>((a + 1) * words),
+                         bits.begin() + static_cast<std::ptrdiff_t>(b * words));
+  } else {
+    bits.resize(rows * words);
+    for (std::size_t r = 0, i = 0; r < count; ++r)
+      for (std::size_t row = 0; row < parts[r].rows; ++row, ++i)
+        std::copy_n(parts[r].moved_bits.begin() + static_cast<std::ptrdiff_t>(row * words), words,
+                    bits.begin() + static_cast<std::ptrdiff_t>((row_at(run.first, i) - y_min) * words));
+  }
+  active.assign_blocks(bits, std::min(run.first, last), std::max(run.first, last), col_lo, col_hi);
 }
 
 // Passes until `active` is empty or the budget is spent: ordered, live sweeps of the active
@@ -813,7 +936,7 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
 // dense pass.
 template <int N, bool Gradient, class Store, class Active>
 ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t, const ErosionBudget& budget,
-                            SweepPath path = SweepPath::Auto) {
+                            SweepPath path = SweepPath::Auto, unsigned threads = 1) {
   ErosionReport report;
   const std::size_t nx = t.layout().nx;
   double moved = 0.0;
@@ -825,7 +948,7 @@ ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t
       const bool dense = forced || (dense_pass_pays(active.size(), spans.nodes) &&
                                     budget.max_updates - report.updates >= 2 * spans.nodes);
       if (dense) {
-        dense_pass<N, Gradient>(store, active, spans, t, report, moved, lanes_for(path));
+        dense_pass<N, Gradient>(store, active, spans, t, report, moved, lanes_for(path), threads);
         continue;
       }
     }
@@ -846,12 +969,12 @@ ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t
 // Dispatches on the stencil size and the rule kind.
 template <class Store, class Active>
 ErosionReport erode_ordered(Store& store, Active& active, const ErosionTables& t, const ErosionBudget& budget,
-                            SweepPath path = SweepPath::Auto) {
+                            SweepPath path = SweepPath::Auto, unsigned threads = 1) {
   if (t.neighbours() == 4)
-    return t.gradient() ? erode_ordered<4, true>(store, active, t, budget, path)
-                        : erode_ordered<4, false>(store, active, t, budget, path);
-  return t.gradient() ? erode_ordered<8, true>(store, active, t, budget, path)
-                      : erode_ordered<8, false>(store, active, t, budget, path);
+    return t.gradient() ? erode_ordered<4, true>(store, active, t, budget, path, threads)
+                        : erode_ordered<4, false>(store, active, t, budget, path, threads);
+  return t.gradient() ? erode_ordered<8, true>(store, active, t, budget, path, threads)
+                      : erode_ordered<8, false>(store, active, t, budget, path, threads);
 }
 
 }  // namespace sb::grid

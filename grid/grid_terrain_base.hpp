@@ -51,6 +51,9 @@ class GridTerrainBase : public Terrain {
   void activate_all() { active_.activate_all(); }
   void activate_block(std::size_t ix, std::size_t iy) { active_.activate_block(ix, iy); }
   void set_sweep_path(SweepPath path) { sweep_path_ = path; }
+  // Threads a large dense pass may run on (1 or 2; dense_pass in erosion_kernel.hpp): a
+  // matter of time only, the heights are the same bit for bit.
+  void set_threads(unsigned threads) { threads_ = threads; }
   // Whether large settling budgets start with the multi-resolution cascade (default on;
   // multires_settle.hpp).
   void set_multires(bool on) { multires_ = on; }
@@ -73,6 +76,7 @@ class GridTerrainBase : public Terrain {
 
  private:
   SweepPath sweep_path_ = SweepPath::Auto;
+  unsigned threads_ = 1;
   bool multires_ = true;
   std::optional<ErosionTables> tables_;  // built on the first erode, rebuilt when the rule changes
 };
@@ -100,7 +104,7 @@ ErosionReport GridTerrainBase<Heights, Active>::erode(const ErosionRule& rule, c
   if (!tables_ || !tables_->built_for(rule, gradient))
     tables_.emplace(heights_.layout(), stencil_.size, rule, gradient);
   const double carry_before = heights_.carry_m3();
-  ErosionReport report = erode_settling(heights_, active_, *tables_, budget, sweep_path_, multires_);
+  ErosionReport report = erode_settling(heights_, active_, *tables_, budget, sweep_path_, multires_, threads_);
   // Transfers conserve volume; only rounding into the carry changes the stored volume.
   report.volume_change_m3 = carry_before - heights_.carry_m3();
   return report;
@@ -122,9 +126,13 @@ template <template <class> class Model>
 std::unique_ptr<Terrain> make_grid_model(const Scene& scene, const HeightField& initial) {
   const GridLayout layout = GridLayout::covering(scene.domain.box(), scene.grid.cell_m);
   const auto z0 = [&initial](const Vec2& p) { return initial(p); };
+  const auto made = [&scene](auto model) -> std::unique_ptr<Terrain> {
+    model->set_threads(static_cast<unsigned>(scene.grid.threads));
+    return model;
+  };
   if (scene.grid.storage == GridStorage::Float)
-    return std::make_unique<Model<float>>(layout, z0, scene.grid.neighbours, scene.erosion.idle_passes);
-  return std::make_unique<Model<double>>(layout, z0, scene.grid.neighbours, scene.erosion.idle_passes);
+    return made(std::make_unique<Model<float>>(layout, z0, scene.grid.neighbours, scene.erosion.idle_passes));
+  return made(std::make_unique<Model<double>>(layout, z0, scene.grid.neighbours, scene.erosion.idle_passes));
 }
 
 }  // namespace sb::grid

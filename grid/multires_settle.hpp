@@ -373,20 +373,22 @@ MultiresReport multires_settle(Store& store, Active& active, const ErosionTables
 
 // Erosion as the terrains run it: the cascade first when it pays (multires_pays), then the
 // fine passes (erode_ordered) within the budget. The cascade's visits count as updates, and
-// as one pass. Both grids call this, so they stay identical.
+// as one pass. Both grids call this, so they stay identical (threads: the fine passes' large
+// dense passes may use two, dense_pass; the heights do not depend on it).
 template <class Store, class Active>
 ErosionReport erode_settling(Store& store, Active& active, const ErosionTables& t, const ErosionBudget& budget,
-                             SweepPath path, bool multires) {
+                             SweepPath path, bool multires, unsigned threads = 1) {
   if (!multires || path != SweepPath::Auto || !multires_pays(active, budget))
-    return erode_ordered(store, active, t, budget, path);
+    return erode_ordered(store, active, t, budget, path, threads);
   MultiresOptions options;
   options.max_box_nodes = static_cast<std::size_t>(budget.max_passes) * active.size();
   const MultiresReport m = multires_settle(store, active, t, options);
-  if (m.levels.empty()) return erode_ordered(store, active, t, budget, path);  // no coarse level, or too large a box
+  if (m.levels.empty())
+    return erode_ordered(store, active, t, budget, path, threads);  // no coarse level, or too large a box
   ErosionBudget rest = budget;
   rest.max_passes -= 1;
   rest.max_updates -= std::min(rest.max_updates, m.updates);
-  ErosionReport r = erode_ordered(store, active, t, rest, path);
+  ErosionReport r = erode_ordered(store, active, t, rest, path, threads);
   r.passes += 1;
   r.updates += m.updates;
   r.transfers += m.transfers;

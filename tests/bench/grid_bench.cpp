@@ -1,9 +1,10 @@
 // Grid back-end benchmarks: erosion throughput (node updates per second: one update is one
 // evaluation of the rule at one node) on realistic active sets of a 512 x 512 grid, on a
-// 2048 x 2048 grid with every node active, against a plain scalar in-place sweep of the same
-// rule in the same run (BM_ReferenceSweep), against a vectorised two-pass (Jacobi) sweep at its
-// monotone fraction (BM_JacobiSweep), time to rest of both orders (BM_Settle*), and stamp cost
-// against tool area; float and double; the pile and stroke also with the gradient rule.
+// 2048 x 2048 grid with every node active (on one thread and on two), against a plain scalar
+// in-place sweep of the same rule in the same run (BM_ReferenceSweep), against a vectorised
+// two-pass (Jacobi) sweep at its monotone fraction (BM_JacobiSweep), time to rest of both
+// orders (BM_Settle*), and stamp cost against tool area; float and double; the pile and
+// stroke also with the gradient rule.
 //
 //   build/<dir>/tests/grid_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 //       --benchmark_enable_random_interleaving=true
@@ -180,11 +181,14 @@ void time_all_active(benchmark::State& state, Copy&& copy, Run&& run) {
   state.counters["updates_per_call"] = benchmark::Counter(updates, benchmark::Counter::kAvgIterations);
 }
 
-template <class Real>
+// Threads: GridTerrain::set_threads (two: each large dense pass runs its two bands at once,
+// erosion_kernel.hpp's dense_pass; the same heights bit for bit).
+template <class Real, unsigned Threads = 1>
 void BM_AllActive(benchmark::State& state) {
   time_all_active<Real>(
       state, [](const GridTerrain<Real>& start) { return start; },
       [](GridTerrain<Real>& t, int passes, const sb::ErosionRule& r) {
+        t.set_threads(Threads);
         const sb::ErosionReport report = t.erode(r, {.max_passes = passes});
         benchmark::DoNotOptimize(report);
         return report.updates;
@@ -192,6 +196,21 @@ void BM_AllActive(benchmark::State& state) {
 }
 BENCHMARK(BM_AllActive<float>)->Name("BM_AllActive<float>")->ArgName("passes")->Arg(4)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_AllActive<double>)->Name("BM_AllActive<double>")->ArgName("passes")->Arg(4)->Unit(benchmark::kMillisecond);
+// On two threads: rates per second of wall time; the CPU time shown is both threads'.
+BENCHMARK(BM_AllActive<float, 2>)
+    ->Name("BM_AllActiveTwoThreads<float>")
+    ->ArgName("passes")
+    ->Arg(4)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime()
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_AllActive<double, 2>)
+    ->Name("BM_AllActiveTwoThreads<double>")
+    ->ArgName("passes")
+    ->Arg(4)
+    ->UseRealTime()
+    ->MeasureProcessCPUTime()
+    ->Unit(benchmark::kMillisecond);
 
 // The reference: a plain scalar in-place sweep of the same rule (sb::erosion_transfers of
 // common/erosion.hpp, edge rule) over every node of the same 2048^2 state, in storage order,

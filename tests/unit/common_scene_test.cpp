@@ -34,6 +34,7 @@ TEST(Scene, MinimalSceneGetsDefaults) {
   EXPECT_DOUBLE_EQ(s.material.critical_angle_deg, 30.0);
   EXPECT_DOUBLE_EQ(s.tin.alpha_flat_deg, 0.4);
   EXPECT_EQ(s.grid.neighbours, 8);
+  EXPECT_EQ(s.grid.threads, 1);
   EXPECT_EQ(s.stroke.path_m.size(), 2u);
 }
 
@@ -81,6 +82,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadField{{"material.transfer_fraction=2.5"}, "material.transfer_fraction", "out of range"},
         BadField{{"grid.cell_m=-1"}, "grid.cell_m", "out of range"},
         BadField{{"grid.neighbours=6"}, "grid.neighbours", "4 or 8"},
+        BadField{{"grid.threads=3"}, "grid.threads", "[1, 2]"},
         BadField{{"stroke.spacing_m=0"}, "stroke.spacing_m", "out of range"},
         BadField{{"stroke.repeat=0"}, "stroke.repeat", "out of range"},
         BadField{{"tin.alpha_flat_deg=50"}, "tin.alpha_flat_deg", "[0, 45]"},

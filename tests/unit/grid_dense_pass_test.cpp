@@ -159,6 +159,65 @@ TEST_P(DensePass, ShortcutGivesThePlainSweepBitForBitOnWideRows) {
     shortcut_is_exact<double>(kWide);
 }
 
+// A pass over spans this large is split into two bands and a seam (dense_pass_splits), and the
+// bands run on two threads where the store allows (double, HeightGrid): the heights, counts
+// and moved volumes are the same bit for bit on one thread or two, dense or sparse, every
+// lane width; volume is conserved; and the split pass settles as the unsplit one does.
+// 301 x 241 nodes (not a multiple of anything): 72,541 nodes, 241 rows.
+const GridLayout kTall = GridLayout::covering({{0.0, 0.0}, {1.5, 1.2}}, kCell);
+
+TEST_P(DensePass, SplitPassIsTheSameOnOneThreadOrTwo) {
+  const Case& c = GetParam();
+  const ErosionRule rule = rule_for(c.rule);
+  const auto run = [&]<class Real>(Real) {
+    auto two = rough_terrain<GridTerrain<Real>>(c, 7, SweepPath::Dense, kTall);
+    ASSERT_TRUE(dense_pass_splits(two->active_set().spans()));
+    two->set_threads(2);
+    auto one = rough_terrain<GridTerrain<Real>>(c, 7, SweepPath::Dense, kTall);
+    auto sparse = rough_terrain<SparseGridTerrain<Real>>(c, 7, SweepPath::Dense, kTall);
+    sparse->set_threads(2);  // runs its bands one after the other: its store is not shared
+    auto narrow = rough_terrain<GridTerrain<Real>>(c, 7, SweepPath::DenseBaseline, kTall);
+    narrow->set_threads(2);
+    const double v0 = two->volume();
+    double tracked = v0;
+    for (int call = 0; call < 3; ++call) {  // passes in both y and x directions
+      const ErosionReport a = two->erode(rule, {.max_passes = 2});
+      tracked += a.volume_change_m3;
+      for (auto* other : {static_cast<Terrain*>(one.get()), static_cast<Terrain*>(sparse.get()),
+                          static_cast<Terrain*>(narrow.get())}) {
+        const ErosionReport b = other->erode(rule, {.max_passes = 2});
+        EXPECT_EQ(a.transfers, b.transfers);
+        EXPECT_EQ(a.updates, b.updates);
+        EXPECT_EQ(a.active, b.active);
+        EXPECT_EQ(a.volume_moved_m3, b.volume_moved_m3);
+      }
+    }
+    const std::vector<double> z = heights_of(*two);
+    for (const std::vector<double>& other : {heights_of(*one), heights_of(*sparse), heights_of(*narrow)}) {
+      std::size_t differing = 0;
+      for (std::size_t k = 0; k < z.size(); ++k) differing += std::memcmp(&z[k], &other[k], sizeof(double)) != 0;
+      EXPECT_EQ(differing, 0u);
+    }
+    EXPECT_NEAR(tracked, two->volume(), (c.is_float ? 1e-12 : 1e-14) * v0);
+    EXPECT_TRUE(two->check().ok());
+    // On to rest: the split passes settle, within a cell of the active-set sweep's surface.
+    auto by_set = rough_terrain<GridTerrain<Real>>(c, 7, SweepPath::ActiveSet, kTall);
+    for (Terrain* t : {static_cast<Terrain*>(two.get()), static_cast<Terrain*>(by_set.get())}) {
+      ErosionReport r;
+      for (int call = 0; call < 100 && (call == 0 || r.active > 0); ++call) r = t->erode(rule, {.max_passes = 50});
+      EXPECT_EQ(r.active, 0u);
+    }
+    const std::vector<double> settled = heights_of(*two), reference = heights_of(*by_set);
+    double worst = 0.0;
+    for (std::size_t k = 0; k < settled.size(); ++k) worst = std::max(worst, std::abs(settled[k] - reference[k]));
+    EXPECT_LE(worst, 1.0 * kCell);
+  };
+  if (c.is_float)
+    run(0.0f);
+  else
+    run(0.0);
+}
+
 TEST_P(DensePass, ConservesAndSettlesCloseToTheActiveSetPath) {
   if (GetParam().is_float)
     paths_agree<float>();
