@@ -113,6 +113,11 @@ VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* insert
   return v;
 }
 
+bool TinTerrain::middle_on_edge(VertexHandle v, VertexHandle w) const {
+  const Vec2 m = 0.5 * (xy(v) + xy(w));
+  return cdt_.geom_traits().orientation_2_object()(v->point(), w->point(), Point(m.x(), m.y(), 0.0)) == CGAL::COLLINEAR;
+}
+
 std::size_t TinTerrain::refine_around(VertexHandle v) {
   // has_long_edges' cached answer, read here: erosion asks for every transfer.
   if (v->info().short_edges) return 0;
@@ -132,7 +137,7 @@ std::size_t TinTerrain::refine_around(VertexHandle v) {
       int i = 0;
       if (!cdt_.is_edge(v, c, f, i)) continue;
       const Vec2 middle = 0.5 * (xy(c) + xy(v));
-      if (f->is_constrained(i) && locate(middle).type != Cdt::EDGE) continue;
+      if (f->is_constrained(i) && !middle_on_edge(v, c)) continue;
       // Nor where a vertex facing the edge lies within kCrowdedSplit refine_m_ of its
       // middle: that vertex already resolves the edge, and the new one would be its close
       // neighbour, two small areas that throttle every transfer through them.
@@ -186,7 +191,7 @@ bool TinTerrain::refine_crease(VertexHandle v) {
   const VertexHandle w = vertex_scratch_[best];
   FaceHandle f;
   int i = 0;
-  if (cdt_.is_edge(v, w, f, i) && f->is_constrained(i) && locate(0.5 * (xy(w) + xy(v))).type != Cdt::EDGE) return false;
+  if (cdt_.is_edge(v, w, f, i) && f->is_constrained(i) && !middle_on_edge(v, w)) return false;
   bool inserted = false;
   split_edge(v, w, &inserted);
   return inserted;

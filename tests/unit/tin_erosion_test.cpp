@@ -232,6 +232,35 @@ TEST(TinErosion, CurvatureRefinementStopsAtAQuarterOfRefineM) {
   EXPECT_LT(tiny.vertices, 2000u);
 }
 
+TEST(TinErosion, SplitsBesideLongConstraintsDoNotWalk) {
+  // A polygon with a 0.2 m spike cut along x leaves contours with long constrained edges; the
+  // erosion after each stamp refines beside them, asking whether a constrained edge's middle
+  // lies exactly on it. That answer is an orientation test: it once located the middle by a
+  // walk from the last edit, often far along the spike (1.53 walk steps per erosion update
+  // here; now 0.32, the walks of the splits' insertions).
+  const Scene s =
+      scene(sb::test::flat_sand_scene("0.5", "0.1",
+                                      "shape = \"polygon\"\ndepth_m = 0.01\n"
+                                      "polygon_m = [[-0.01, -0.01], [0.01, -0.01], [0.2, 0.0], "
+                                      "[0.01, 0.01], [-0.01, 0.01]]\n",
+                                      "[stroke]\npath_m = [[0.05, 0.25], [0.25, 0.25]]\nspacing_m = 0.01\n"));
+  auto t = make(s);
+  const double v0 = t->volume();
+  std::uint64_t walked = 0, updates = 0;
+  for (const ToolStamp& st : schedule_of(s).stamps) {
+    t->stamp(st);
+    const std::uint64_t before = t->stats().walk_steps;
+    updates += t->erode(rule_of(s), ErosionBudget{s.erosion.max_passes_per_step}).updates;
+    walked += t->stats().walk_steps - before;
+    t->simplify(SimplifyParams{s.tin.alpha_flat_deg});
+  }
+  RecordProperty("walk_steps_per_update", std::to_string(static_cast<double>(walked) / updates));
+  EXPECT_GT(updates, 1000u);
+  EXPECT_LT(static_cast<double>(walked), 1.0 * static_cast<double>(updates));
+  EXPECT_NEAR(t->volume(), v0, 1e-12 * v0);
+  SB_EXPECT_TIN_OK(*t);
+}
+
 TEST(TinErosion, RefusesABadRule) {
   const Scene s = scene();
   auto t = make(s);

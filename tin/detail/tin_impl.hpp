@@ -306,6 +306,11 @@ class TinTerrain final : public Terrain {
   // edge only where its middle is exactly on it, no edge whose middle a facing vertex crowds);
   // returns the number of splits.
   std::size_t refine_around(VertexHandle v);
+  // Whether the middle of edge (v, w), as rounded, lies exactly on it (exact orientation): a
+  // constrained edge is split only there, else the new vertex would sit beside the constraint,
+  // in a sliver. O(1); locating the middle instead walked from the last edit, which after a
+  // long stamp is hundreds of faces away (the spike cliffs: 5,700 walk steps per stamp).
+  bool middle_on_edge(VertexHandle v, VertexHandle w) const;
   // settle_region.cpp: the coarse-to-fine cascade (tin/settle_cascade.hpp) over the region
   // around L_e, when the budget is a settling one (cascade_pays); the vertices it changes join
   // L_e with their neighbours, and L_r. Counted in `report` as one pass.
