@@ -133,6 +133,7 @@
 #include <cstring>
 #include <exception>
 #include <limits>
+#include <system_error>
 #include <thread>
 #include <type_traits>
 #include <utility>
@@ -841,6 +842,38 @@ constexpr bool bands_run_together() {
   &&!requires(Store & s) { s.read_row(0, 0, 0, nullptr); };
 }
 
+// Runs first() on this thread and second() on a thread of its own when `together` (and a
+// thread can be had), else one after the other; both have run when it returns, and an
+// exception from either is thrown on once both have stopped.
+template <class First, class Second>
+void run_both(bool together, First&& first, Second&& second) {
+  std::thread other;
+  std::exception_ptr failed;
+  if (together) {
+    try {
+      other = std::thread([&] {
+        try {
+          second();
+        } catch (...) {
+          failed = std::current_exception();
+        }
+      });
+    } catch (const std::system_error&) {  // no thread to be had: one after the other
+    }
+  }
+  try {
+    first();
+  } catch (...) {
+    if (other.joinable()) other.join();  // a running thread is joined before the stack unwinds
+    throw;
+  }
+  if (other.joinable())
+    other.join();
+  else
+    second();
+  if (failed) std::rethrow_exception(failed);
+}
+
 // One dense pass (dense_rows) in the given lanes, then the active set updated word by word
 // (assign_blocks). Large passes (dense_pass_splits) go in a fixed order of three runs: the
 // first band (the first half of the spans' rows in the sweep's direction, up to two rows
@@ -878,22 +911,9 @@ void dense_pass(Store& store, Active& active, const typename Active::Spans& span
     first_band.rows = band_rows;
     second_band.first = row_at(run.first, band_rows + 2);
     second_band.moved = 0.0;
-    if (bands_run_together<Store>() && threads >= 2) {
-      std::exception_ptr failed;
-      std::thread other([&] {
-        try {
-          go(second_band, parts[2]);
-        } catch (...) {
-          failed = std::current_exception();
-        }
-      });
-      go(first_band, parts[0]);
-      other.join();
-      if (failed) std::rethrow_exception(failed);
-    } else {
-      go(first_band, parts[0]);
-      go(second_band, parts[2]);
-    }
+    run_both(
+        bands_run_together<Store>() && threads >= 2, [&] { go(first_band, parts[0]); },
+        [&] { go(second_band, parts[2]); });
     seam.first = row_at(run.first, band_rows);
     seam.rows = 2;
     seam.live_lo = parts[0].live_lo, seam.live_hi = parts[0].live_hi;
