@@ -6,8 +6,11 @@ to settle grow as (L / h)^2 while the active region grows as n, so the time can 
 this table says how the grids scale here, for both erosion rules."""
 import sbrun
 
-# (label, backend, overrides): the default rule on both grids, and the paper's rule on the dense one.
-VARIANTS = [("grid", "grid", []), ("grid (edge rule)", "grid", [sbrun.PAPER_RULE]), ("sparse", "sparse", [])]
+# (label, backend, overrides): the default rule on both grids, and the paper's rule on the dense one;
+# the dense grid also on two threads (its large dense passes run two bands of rows at once: the
+# same heights and work, other times).
+VARIANTS = [("grid", "grid", []), ("grid (edge rule)", "grid", [sbrun.PAPER_RULE]), ("sparse", "sparse", []),
+            ("grid, 2 threads", "grid", ["grid.threads=2"])]
 TARGET_S, TARGET_EXPONENT = 3.0, 1.2  # at 5.1 M nodes; over 0.32 M..5.1 M nodes
 
 
@@ -23,7 +26,7 @@ def run(ctx):
 
     rows, fits = [], {}
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    for (label, _, _), marker in zip(VARIANTS, "os^"):
+    for (label, _, _), marker in zip(VARIANTS, "os^D"):
         runs = by_variant[label]
         nodes = [r["cells"] for r in runs]
         total = [r["time_s.total"] + r["time_s.relax"] for r in runs]
@@ -56,6 +59,8 @@ def run(ctx):
     largest = grid[-1]
     largest_s = largest["time_s.total"] + largest["time_s.relax"]
     exponent = fits["grid"][0]
+    two = by_variant["grid, 2 threads"][-1]
+    two_s = two["time_s.total"] + two["time_s.relax"]
     meets = largest["cells"] >= 5e6 and largest_s <= TARGET_S and exponent <= TARGET_EXPONENT
     return f"""## Settling against resolution
 
@@ -73,6 +78,16 @@ cascade (grid/multires_settle.hpp) when it pays.
   {'met' if meets else 'not met' if largest['cells'] >= 5e6 else 'not measured at 5.1 M nodes by this profile'}.
 - The paper's edge rule: exponent {fits['grid (edge rule)'][0]:.2f}; the sparse grid: {fits['sparse'][0]:.2f}
   (it runs the dense grid's kernel on its own storage).
+- On two threads (`grid.threads = 2`): {two_s:.2f} s at {two['cells'] / 1e6:.1f} M nodes against one thread's
+  {largest_s:.2f} s, with {'the same' if two['relax_updates'] == largest['relax_updates'] else 'DIFFERENT'} settling
+  updates (the heights do not depend on the threads). Little to gain here: only passes over at least 2^16 nodes in
+  32 rows split into bands, and at 5.1 M nodes the cascade's coarse levels (one thread) take about as much time as
+  the dense passes (perf, sampled: 10.3 % and 10.4 % of the run's samples, the rest the stroke, the active-set
+  sweeps, the run file), not all of which are that large (alone on the machine, 3 interleaved runs at 5.1 M nodes:
+  settling 0.41 s on one thread, 0.38-0.40 s on two); these runs also go two at a time, so a second thread
+  competes with the other run.
+  Two threads pay where most of a large grid is active at once (`grid_bench`'s `BM_AllActiveTwoThreads`: 1.8x).
+  The comparison with the TIN runs one thread.
 - Exponents come from single runs on a shared machine, two at a time; the update counts are exact.
 """
 
