@@ -57,7 +57,8 @@
 // grains stop, not in conservation: within a cell of each other on random rough states
 // (tests/unit/grid_dense_pass_test.cpp) and within the goldens' bounds on the shipped scenes.
 // The choice and the order depend only on the active set, so the dense and sparse grids still
-// compute the same heights bit for bit.
+// compute the same heights bit for bit. A large dense pass goes as two bands of rows and the
+// seam between them (dense_pass), which may run on two threads: the same order either way.
 //
 // Energy. Each visit sees the heights left by the visits before it, and moves at most f
 // times the largest pair excess, split in proportion to the pair excesses: for f <= 1 no
