@@ -839,8 +839,9 @@ bool dense_pass_splits(const Spans& spans) {
 // before (height_grid.hpp), and a sparse store's accessors and row windows are not shared.
 template <class Store>
 constexpr bool bands_run_together() {
-  return !Store::kRounds && requires(Store & s) { s.data(); }
-  &&!requires(Store & s) { s.read_row(0, 0, 0, nullptr); };
+  constexpr bool contiguous = requires(Store & s) { s.data(); };
+  constexpr bool windowed = requires(Store & s) { s.read_row(0, 0, 0, nullptr); };
+  return !Store::kRounds && contiguous && !windowed;
 }
 
 // Runs first() on this thread and second() on a thread of its own when `together` (and a
