@@ -294,6 +294,14 @@ TEST(DensePassActiveSet, AssignBlocksOverColumnsIsOverWholeRows) {
   }
 }
 
+// Which stores run a split pass's bands at once (the rest run them one after the other, with
+// the same heights): double heights in one array only.
+TEST(DensePassChoice, BandsRunTogetherOnDoubleArraysOnly) {
+  EXPECT_TRUE(bands_run_together<HeightGrid<double>>());
+  EXPECT_FALSE(bands_run_together<HeightGrid<float>>());  // the rounding carry chains the writes
+  EXPECT_FALSE(bands_run_together<SparseHeights<double>>());
+}
+
 // Auto takes the dense pass when many nodes are members, the active-set sweep when few.
 TEST(DensePassChoice, DenseWhenManyActive) {
   EXPECT_TRUE(dense_pass_pays(1000, 8000));
