@@ -340,9 +340,9 @@ notes); the tables below are this run's.
   pass (2^16 nodes in 32 rows or more) now runs as two bands of rows and the two-row seam between them
   (rows three apart touch disjoint rows, so the bands may run at once; the seam goes after, and the
   heights are the same bit for bit on one thread or two): with `grid.threads = 2` (`grid_bench`'s
-  `BM_AllActiveTwoThreads`, double) 341-349 M updates/s of wall time with every node of 2048^2 active,
-  1.8x one thread's 193 and 22x the scalar sweep, for the same CPU time (87 ms for 4 passes either
-  way). The comparison runs `grid.threads = 1`, so that the grid is timed on one core as the TIN is;
+  `BM_AllActiveTwoThreads`, double) 316-349 M updates/s of wall time with every node of 2048^2 active
+  (medians of 7 in two runs, the lower with another job on the machine), 1.7-1.8x one thread's 191-193
+  and 21-22x the scalar sweep, for about the same CPU time (87-93 ms for 4 passes against 87). The comparison runs `grid.threads = 1`, so that the grid is timed on one core as the TIN is;
   float runs its bands one after the other (its rounding carry chains the writes). Tried and measured, not
   kept (ratios pile / stroke / all active): keeping a chunk of a row in registers across its three
   column phases, which saves the permutes that gather a 3 x 3 block per lane but makes each chunk wait

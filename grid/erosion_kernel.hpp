@@ -101,9 +101,10 @@
 // dense_pass_avx512; two cores shared with other jobs, so figures move by ~5 % between runs),
 // M updates/s (an update: one node of a span or one active-set visit), now (before): double 102
 // on the pile (101), 158 on the stroke (156), 194 with every node of 2048^2 active (196; 12.5x
-// the plain scalar sweep's 15.5 in the same runs) on one thread, 341-349 of wall time on two
-// (dense_pass's bands at once; 1.8x one thread's 193 in the same runs, the same CPU time, 22x
-// the scalar sweep); float 51 (49), 70 (67), 99 (95); the
+// the plain scalar sweep's 15.5 in the same runs) on one thread, 316-349 of wall time on two
+// (dense_pass's bands at once; medians of 7 in two runs, the lower with another job on the
+// machine: 1.7-1.8x one thread's 191-193, about the same CPU time, 21-22x the scalar sweep);
+// float 51 (49), 70 (67), 99 (95); the
 // gradient rule (AVX-512 lanes only; AVX2 visits it one node at a time), double: 70 on the pile
 // and 101 on the stroke (66, 97). Measured in the AVX2 lanes (callgrind, which runs no AVX-512;
 // the instructions of erode_ordered per update, unchanged by that build), double / float:
