@@ -54,6 +54,7 @@ class GridTerrainBase : public Terrain {
   // Threads a large dense pass may run on (1 or 2; dense_pass in erosion_kernel.hpp): a
   // matter of time only, the heights are the same bit for bit.
   void set_threads(unsigned threads) { threads_ = threads; }
+  unsigned threads() const { return threads_; }
   // Whether large settling budgets start with the multi-resolution cascade (default on;
   // multires_settle.hpp).
   void set_multires(bool on) { multires_ = on; }

@@ -192,19 +192,21 @@ TEST(GridHeights, FloatWritesCarryTheirRoundingError) {
   EXPECT_NEAR(h.volume(), v0, 1e-14 * v0);
 }
 
-TEST(GridFactory, FollowsTheSceneStorageAndNeighbours) {
+TEST(GridFactory, FollowsTheSceneStorageNeighboursAndThreads) {
   const Scene sd = scene();
   const auto d = make_grid_terrain(sd, HeightField::from_scene(sd));
   const auto* dg = dynamic_cast<const GridTerrain<double>*>(d.get());
   ASSERT_NE(dg, nullptr);
   EXPECT_EQ(dg->stencil().size, 8);
   EXPECT_EQ(dg->layout().nx, 101u);
+  EXPECT_EQ(dg->threads(), 1u);
 
-  const Scene sf = scene({"grid.storage=float", "grid.neighbours=4"});
+  const Scene sf = scene({"grid.storage=float", "grid.neighbours=4", "grid.threads=2"});
   const auto f = make_grid_terrain(sf, HeightField::from_scene(sf));
   const auto* fg = dynamic_cast<const GridTerrain<float>*>(f.get());
   ASSERT_NE(fg, nullptr);
   EXPECT_EQ(fg->stencil().size, 4);
+  EXPECT_EQ(fg->threads(), 2u);
   EXPECT_NEAR(f->volume(), 0.5 * 0.5 * 0.1, 1e-9);
   SB_EXPECT_CHECK_OK(*f);
 }
