@@ -308,8 +308,8 @@ class TinTerrain final : public Terrain {
   std::size_t refine_around(VertexHandle v);
   // Whether the middle of edge (v, w), as rounded, lies exactly on it (exact orientation): a
   // constrained edge is split only there, else the new vertex would sit beside the constraint,
-  // in a sliver. O(1); locating the middle instead walked from the last edit, which after a
-  // long stamp is hundreds of faces away (the spike cliffs: 5,700 walk steps per stamp).
+  // in a sliver. O(1); locating the middle instead walked from the last edit, often far along
+  // a long stamp's contour (a 0.2 m spike's run: 119,641 walk steps in all with it, 39,712 now).
   bool middle_on_edge(VertexHandle v, VertexHandle w) const;
   // settle_region.cpp: the coarse-to-fine cascade (tin/settle_cascade.hpp) over the region
   // around L_e, when the budget is a settling one (cascade_pays); the vertices it changes join
