@@ -18,6 +18,8 @@ CLIFFS = {
     "angle_5": ("critical angle 5 degrees", ["material.critical_angle_deg=5"], False),
     "angle_1e-6": ("critical angle 1e-6 degrees", ["material.critical_angle_deg=1e-6"], False),
     "box_0.4mm": ("a 0.4 mm box (below one grid cell)", ["tool.shape=box", "tool.size_m=[0.0004, 0.0004]"], True),
+    # Just wider than the TIN's uncut footprints (a quarter of tin.refine_m, 1.7 mm here): cut in.
+    "box_2mm": ("a 2 mm box (the narrowest the TIN cuts in)", ["tool.shape=box", "tool.size_m=[0.002, 0.002]"], True),
     "blade_sideways": ("a 10 x 60 mm box swept sideways (a blade)", ["tool.shape=box", "tool.size_m=[0.01, 0.06]"],
                        True),
     "spike_ahead": ("a 0.2 m spike pointing along the motion",
@@ -76,8 +78,10 @@ def run(ctx):
   `flat_stroke.toml` with the overrides named; the bar (issue 11): the TIN within 10x the grid's time,
   settled, drift at most 1e-6. Within it: {len(cliffs) - len(missed)} of {len(cliffs)}; missed:
   {', '.join(missed) or 'none'}.
-- A tool below one grid cell (the 0.4 mm box, the spikes' thin ends) is where the ratio says least: the
-  grid's 5 mm cells miss most of the footprint and move almost no sand, while the TIN cuts it.
+- A tool below one grid cell (the boxes, the spikes' thin ends) is where the ratio says least: the grid's
+  5 mm cells miss most of the footprint and move almost no sand. The TIN cuts a footprint into its mesh
+  when it is at least a quarter of `tin.refine_m` wide (4 area / perimeter; 1.7 mm here), so it cuts the
+  2 mm box; the 0.4 mm box lowers the vertices it covers, as the grid lowers its nodes (here none).
 """
 
 

@@ -26,7 +26,8 @@
 //   stamp             O(k): contours inserted, old constraints dropped, constraints enforced,
 //                     vertices removed, the rim refined (about 0.4 ms for a 1.5 cm disk); a
 //                     convex footprint keeps one corner per refine_m_ of perimeter (8 to 64,
-//                     evenly spaced, same area), so tool.sides = 4096 costs what 16 sides do
+//                     evenly spaced, same area), so tool.sides = 4096 costs what 16 sides do;
+//                     one narrower than refine_m / 4 is not cut in: O(vertices it covers)
 //   erode             O(|L_e| * degree) per pass, about 0.2 us per vertex visit; an edge
 //                     split is O(1). A visit reads its vertex's ring from L_e's cache (the
 //                     neighbours in CGAL's circulator order, walked again only after the star

@@ -84,6 +84,76 @@ TEST(TinStamp, ManySidedToolsAreCutToWhatTheMeshResolves) {
   EXPECT_EQ(u->stats().constrained_edges, 16u);
 }
 
+// A square footprint of side `side` centred on c.
+std::vector<Vec2> square(const Vec2& c, double side) {
+  const double h = 0.5 * side;
+  return {c + Vec2(-h, -h), c + Vec2(h, -h), c + Vec2(h, h), c + Vec2(-h, h)};
+}
+
+TEST(TinStamp, AFootprintNarrowerThanTheMeshResolvesLowersTheVerticesItCovers) {
+  // kFlatScene refines to 10 mm: footprints narrower than 2.5 mm (4 area / perimeter) are not
+  // cut in. A 1 mm box between vertices changes nothing, as between a grid's nodes.
+  const Scene s = scene();
+  auto t = make(s);
+  const double v0 = t->volume();
+  ToolStamp box = stamp_at(s, {0.25, 0.25}, 0.09);
+  box.footprint = square({0.25, 0.25}, 0.001);
+  const StampReport r = t->stamp(box);
+  SB_EXPECT_TIN_OK(*t);
+  EXPECT_EQ(r.vertices_inserted, 0u);
+  EXPECT_EQ(r.volume_removed_m3, 0.0);
+  EXPECT_EQ(t->stats().vertices, 4u);
+  EXPECT_EQ(t->stats().constrained_edges, 0u);
+  EXPECT_EQ(t->volume(), v0);
+
+  // Over a vertex of a 10 mm lattice: the vertex goes down to the tool, the volume is kept.
+  // With the box's own rim (half its half-side, as the scene sets it), the band holds no
+  // vertex: the sand goes to the ring around the vertex, raised evenly, nothing inserted.
+  // With a 2 cm disk's rim (10 mm) the band's vertices take it, refined as for a cut stamp.
+  for (const double side : {0.001, 0.0024}) {
+    for (const double rim : {0.25 * side, 0.01}) {
+      const Scene ls = scene(kFlatScene, {"tin.initial_points=2500"});
+      auto lattice = make(ls);
+      const double before = lattice->volume();
+      const std::size_t n = lattice->stats().vertices;
+      Vec2 c = lattice->mesh().vertices.front().head<2>();
+      for (const Vec3& v : lattice->mesh().vertices)
+        if ((v.head<2>() - Vec2(0.25, 0.25)).norm() < (c - Vec2(0.25, 0.25)).norm()) c = v.head<2>();
+      ToolStamp over = stamp_at(ls, c, 0.09);
+      over.footprint = square(c, side);
+      over.rim.width_m = rim;
+      const StampReport lowered = lattice->stamp(over);
+      SB_EXPECT_TIN_OK(*lattice);
+      EXPECT_EQ(lattice->stats().constrained_edges, 0u) << side << " " << rim;
+      EXPECT_NEAR(lattice->height(c), 0.09, 1e-15) << side << " " << rim;
+      EXPECT_GT(lowered.volume_removed_m3, 0.0) << side << " " << rim;
+      EXPECT_NEAR(lowered.volume_deposited_m3, lowered.volume_removed_m3, 1e-12 * lowered.volume_removed_m3);
+      EXPECT_NEAR(lattice->volume(), before, 1e-15 * before) << side << " " << rim;
+      if (rim > side) continue;
+      EXPECT_EQ(lattice->stats().vertices, n) << side;
+      std::vector<double> raised;
+      for (const Vec3& v : lattice->mesh().vertices) {
+        if (v.head<2>() == c) continue;
+        EXPECT_GE(v.z(), 0.1) << side;
+        if (v.z() > 0.1) raised.push_back(v.z());
+        EXPECT_LT((v.head<2>() - c).norm(), v.z() > 0.1 ? 0.02 : 1.0) << side;
+      }
+      ASSERT_GE(raised.size(), 3u) << side;
+      for (double z : raised) EXPECT_NEAR(z, raised.front(), 1e-15) << side;
+    }
+  }
+
+  // tin.refine_m = 2 mm resolves it: cut in with its contours (4 constrained edges each).
+  const Scene fine = scene(kFlatScene, {"tin.refine_m=0.002"});
+  auto u = make(fine);
+  ToolStamp cut = stamp_at(fine, {0.25, 0.25}, 0.09);
+  cut.footprint = square({0.25, 0.25}, 0.001);
+  u->stamp(cut);
+  SB_EXPECT_TIN_OK(*u);
+  EXPECT_EQ(u->stats().constrained_edges, 8u);
+  EXPECT_NEAR(u->height({0.25, 0.25}), 0.09, 1e-15);
+}
+
 TEST(TinStamp, ReachesTheToolDepthInsideTheFootprint) {
   for (const std::string& text : {kFlatScene, kDunesScene}) {
     const Scene s = scene(text);

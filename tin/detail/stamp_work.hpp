@@ -1,6 +1,7 @@
 #pragma once
 // Private to tin/stamp.cpp: one stamp's working state, passed from step to step (the paper's
 // steps 1a-1f, TinTerrain::stamp). Plain data; the steps are TinTerrain members.
+#include <algorithm>
 #include <utility>
 #include <vector>
 
@@ -19,6 +20,9 @@ struct StampWork {
   // The stamp as applied: its footprint counter-clockwise, without near-duplicate corners,
   // and a many-sided convex one cut to the corners the mesh resolves (same area).
   ToolStamp tool;
+  // Whether the footprint is cut into the mesh (steps 1a-1e). One narrower than the mesh
+  // resolves (TinTerrain::resolves) lowers the vertices it covers instead, as a grid's nodes.
+  bool cut = true;
   double tiny = 0.0;                         // a length below rounding at the domain's scale
   double margin = 0.0;                       // what snapping may move a point by, and then some
   double gap = 0.0;                          // between the footprint I and the outer contour O
@@ -43,6 +47,14 @@ struct StampWork {
   std::vector<VertexHandle> changed;                           // heights changed (lowered or raised)
   double lowered_volume = 0.0;                                 // taken out by 1d
 
+  // footprint_bounds, inside_radius and reach_radius from the footprint and the rim. O(corners).
+  void bound_footprint() {
+    footprint_bounds = bounds(tool.footprint).expanded(2.0 * tiny);
+    const Vec2 centre = tool.pose.xy;
+    if (tool.contains(centre)) inside_radius = std::max(0.0, distance_to_boundary(tool.footprint, centre) - 2.0 * tiny);
+    for (const Vec2& p : tool.footprint) reach_radius = std::max(reach_radius, (p - centre).norm());
+    reach_radius += std::max(tool.rim.width_m, 0.0) + 2.0 * tiny;
+  }
   // Strictly inside, off the boundary (the inscribed circle's test, O(1)).
   bool deep_inside(const Vec2& p) const { return (p - tool.pose.xy).squaredNorm() < inside_radius * inside_radius; }
   bool in_footprint(const Vec2& p) const {

@@ -258,6 +258,10 @@ class TinTerrain final : public Terrain {
   // The footprint made ready (checked, cut to what the mesh resolves), the contours O and I
   // clipped to the domain; false when O misses the domain.
   bool plan_stamp(const ToolStamp& s, StampWork& w);
+  // Whether the mesh resolves a footprint (its width against refine_m_), so it is cut in. O(corners).
+  bool resolves(const std::vector<Vec2>& footprint) const;
+  // The vertices outside an uncut footprint nearest to the ones it lowered (ring by ring).
+  std::vector<VertexHandle> nearest_outside(const StampWork& w);
   void contour_points(StampWork& w) const;                   // 1a: O's heights, I, interior and rim points
   int long_edge_pieces(const Vec2& a, const Vec2& b) const;  // pieces of a contour edge (1: whole)
   void find_constraints_near(StampWork& w);                  // old constraints within reach of O (w.dropped)
