@@ -37,7 +37,8 @@ struct ErosionBudget {
   std::size_t max_updates = std::numeric_limits<std::size_t>::max();  // element visits
   // The sand is left to come to rest (no tool this step: the runner's settling, an idle
   // interactive step). A back-end may spend work here that only pays at rest; the TIN refines
-  // creases then when tin.curvature_when = "settling".
+  // creases then when tin.curvature_when = "settling", and counts its last stamp as passed
+  // (constraints dropped, contours thinned).
   bool settling = false;
   // Settling budgets may start with a back-end's coarse-to-fine cascade (erosion.cascade): the
   // grid's multires_settle, the TIN's clusters. false: the fine rule's own passes only.

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "common/input_error.hpp"
@@ -132,6 +133,14 @@ void TinTerrain::spread_volume(const std::vector<VertexHandle>& vertices, double
     touch_with_neighbours(v);
     add_to_simplify(v);
   }
+}
+
+void TinTerrain::release_passed_stamps() {
+  if (generations_.empty()) return;
+  std::vector<VertexHandle> region;
+  const double delta = drop_stale_constraints(std::numeric_limits<std::uint32_t>::max(), region);
+  volume_change_ += delta;
+  if (spec_.conserve_volume) spread_volume(region, -delta);
 }
 
 void TinTerrain::snap_border_crossings(std::vector<Vec2>& contour, double reach) {

@@ -33,7 +33,9 @@
 //                     neighbours in CGAL's circulator order, walked again only after the star
 //                     changed; check() compares it with the star), heights and cached areas
 //                     fresh; no allocation per visit (scratch and pool grow amortized).
-//                     Settling budgets (the runner's, >= 32 passes) with >= 512 active
+//                     A settling budget (no tool) first drops the last stamp's constraints
+//                     and thins its contours, O(its contours). Settling budgets (the
+//                     runner's, >= 32 passes) with >= 512 active
 //                     vertices first run a coarse-to-fine cascade over the region around L_e
 //                     (settle_cascade.hpp: clusters of refinement-length cells, none with
 //                     erosion.cascade = false, then the fine rule over plain arrays),

@@ -250,6 +250,31 @@ TEST(TinStamp, OldGenerationsAreDroppedOnceTheStampHasPassed) {
   EXPECT_NEAR(t->volume(), 0.025, 1e-12);
 }
 
+TEST(TinStamp, WithNoToolTheLastStampHasPassedToo) {
+  // A stroke's erosion keeps the last stamp's constraints (the tool may come back); a settling
+  // budget (no tool) drops them and thins its contours, the flips' change given back.
+  for (const std::string& text : {kFlatScene, kDunesScene}) {
+    const Scene s = scene(text);
+    auto t = make(s);
+    const double v0 = t->volume();
+    for (int k = 0; k < 3; ++k) {
+      const Vec2 c(0.2 + 0.01 * k, 0.25);
+      step(*t, s, stamp_at(s, c, t->height(c) - 0.01, {1, 0}, static_cast<std::uint32_t>(k)));
+    }
+    ASSERT_GT(t->stats().constrained_edges, 0u);
+    const std::size_t before = t->stats().vertices;
+    t->erode(rule_of(s), ErosionBudget{.max_passes = 1});
+    EXPECT_GT(t->stats().constrained_edges, 0u);
+    // (No passes: the release alone.)
+    const ErosionReport r = t->erode(rule_of(s), ErosionBudget{.max_passes = 0, .settling = true});
+    SB_EXPECT_TIN_OK(*t);
+    EXPECT_EQ(t->stats().constrained_edges, 0u);
+    EXPECT_LT(t->stats().vertices, before);  // the tops of its O and I pairs
+    EXPECT_NEAR(r.volume_change_m3, 0.0, 1e-15);
+    EXPECT_NEAR(t->volume(), v0, 1e-13 * v0);
+  }
+}
+
 TEST(TinStamp, APassedStampLeavesNoWallThinnerThanTheMeshResolves) {
   // O and I lie a contour gap (1 mm) apart, a tenth of the mesh's edges (tin.refine_m): once
   // the stamp has passed, the top of each such pair goes (under tin.conserve_volume, which

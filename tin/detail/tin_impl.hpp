@@ -291,6 +291,9 @@ class TinTerrain final : public Terrain {
   // Raises the vertices by one dz that adds `volume` (a stamp off the domain gives the flips'
   // change back so). O(vertices x degree).
   void spread_volume(const std::vector<VertexHandle>& vertices, double volume);
+  // With no tool (a settling budget), every stamp has passed: its constraints dropped and its
+  // contours thinned, the flips' volume change given back (tin.conserve_volume). O(as above).
+  void release_passed_stamps();
   // Moves the points of a clipped contour that lie on the domain's border onto an existing
   // border vertex within `reach` on the same side, if there is one. O(points x vertices near).
   void snap_border_crossings(std::vector<Vec2>& contour, double reach);
