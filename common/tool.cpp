@@ -121,8 +121,11 @@ double ToolStamp::bottom_z(const Vec2& p) const {
 double ToolStamp::rim_weight(const Vec2& p) const {
   if (footprint.empty() || rim.width_m <= 0.0) return 0.0;
   if (contains(p)) return 0.0;
-  const double d = distance_to_boundary(footprint, p);
-  if (d >= rim.width_m) return 0.0;
+  return rim_weight_outside(p, distance_to_boundary(footprint, p));
+}
+
+double ToolStamp::rim_weight_outside(const Vec2& p, double d) const {
+  if (rim.width_m <= 0.0 || d >= rim.width_m) return 0.0;
   const double taper = 1.0 - d / rim.width_m;
   double directional = 1.0;
   const Vec2 offset = p - pose.xy;

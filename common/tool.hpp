@@ -78,6 +78,8 @@ struct ToolStamp {
   // rim band, else (1 + bias cos(phi)) / (1 + bias) * taper, with phi the angle between
   // the motion and (p - pose), and the taper falling linearly across the band.
   double rim_weight(const Vec2& p) const;
+  // The same for a point outside the footprint whose distance to its boundary is known.
+  double rim_weight_outside(const Vec2& p, double distance) const;
   // Footprint bounds grown by the rim band.
   Aabb2 influence_bounds() const;
 };

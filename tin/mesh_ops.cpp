@@ -407,9 +407,6 @@ Capture TinTerrain::begin_capture(const Aabb2& box) {
     }
   }
   c.faces = face_scratch_.size();
-  c.outer_index.reserve(c.outer.size());
-  for (const OuterFace& o : c.outer) c.outer_index.push_back(&*o.face);
-  std::sort(c.outer_index.begin(), c.outer_index.end());
   return c;
 }
 
@@ -417,7 +414,12 @@ CaptureResult TinTerrain::end_capture(Capture& c, std::vector<VertexHandle>* reg
   CaptureResult r;
   r.volume_before = c.volume;
   r.area_before = c.area;
-  auto is_outer = [&c](FaceHandle f) { return std::binary_search(c.outer_index.begin(), c.outer_index.end(), &*f); };
+  // The fence marked afresh (the edits since begin_capture marked faces for their own walks):
+  // every recorded outer face still in use, as a search of the recorded addresses would find.
+  const std::uint32_t fence = next_face_epoch();
+  for (const OuterFace& o : c.outer)
+    if (cdt_.tds().faces().is_used(o.face)) o.face->info() = fence;
+  const auto is_outer = [fence](FaceHandle f) { return f->info() == fence; };
   // The outer faces must have survived unchanged; then they fence in the same area. The walk
   // over the region after starts from the first of them in discovery order, so the order of
   // the region's vertices (and of the erosion list they join) does not depend on addresses.

@@ -66,7 +66,10 @@ struct StampWork {
   double rim_weight(const Vec2& p) const {
     const double d2 = (p - tool.pose.xy).squaredNorm();
     if (d2 < inside_radius * inside_radius || d2 > reach_radius * reach_radius) return 0.0;
-    return in_footprint(p) ? 0.0 : tool.rim_weight(p);
+    // in_footprint and ToolStamp::rim_weight with one distance to the boundary between them.
+    if (tool.contains(p)) return 0.0;
+    const double d = distance_to_boundary(tool.footprint, p);
+    return footprint_bounds.contains(p) && d <= tiny ? 0.0 : tool.rim_weight_outside(p, d);
   }
   // A tool deeper than the bed stops at its floor, z = 0: there is no sand below to push away.
   double bottom(const Vec2& p) const { return std::max(tool.bottom_z(p), 0.0); }

@@ -112,10 +112,7 @@ struct OuterFace {
 };
 struct Capture {
   std::vector<OuterFace> outer;  // finite faces just outside the region, in discovery order
-  // Their addresses, sorted: for membership tests only (never iterated, because addresses
-  // differ between processes and so must not decide anything a run computes).
-  std::vector<const void*> outer_index;
-  double volume = 0.0;  // integral of z over the region before
+  double volume = 0.0;           // integral of z over the region before
   double area = 0.0;
   std::size_t faces = 0;
 };
