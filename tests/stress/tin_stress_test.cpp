@@ -276,6 +276,55 @@ path_m = [[0.05, 0.05]]
   EXPECT_NEAR(run.terrain->volume(), v0, 1e-11 * v0);
 }
 
+TEST(TinStress, ToolsNarrowerThanTheMeshAmongCutOnes) {
+  // Footprints below a quarter of tin.refine_m (uncut: the vertices they cover lowered) and
+  // just above it (cut in), in random strokes over a lattice TIN and dunes, crossing the border;
+  // then settling, which releases the last stamp. check() and the volume after every phase.
+  for (std::uint64_t seed : {4u, 5u}) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    Runner run(parse_scene(seed == 4 ? kScene : kDunes, "stress",
+                           {"tin.conserve_volume=true", seed == 4 ? "tin.initial_points=4000" : "tin.snap_m=1e-6"}));
+    const double v0 = run.terrain->volume();
+    // tin.refine_m: half the scene's disk radius (10 and 7.5 mm); footprints narrower than a
+    // quarter of it (4 area / perimeter) are not cut in.
+    const double quarter = 0.25 * 0.5 * run.scene.tool.radius_m;
+    std::size_t uncut = 0;
+    for (int stroke = 0; stroke < 8; ++stroke) {
+      ToolSpec tool = run.scene.tool;
+      const double width = (0.1 + 1.7 * u(rng)) * quarter;
+      double footprint_width = width;  // a disk's diameter, a w x l box's 2 w l / (w + l)
+      if (u(rng) < 0.5) {
+        const double length = width * (1.0 + 3.0 * u(rng));
+        tool.shape = ToolShape::Box;
+        tool.half_size_m = {0.5 * width, 0.5 * length};
+        footprint_width = 2.0 * width * length / (width + length);
+      } else {
+        tool.radius_m = 0.5 * width;
+      }
+      tool.rim.width_m = u(rng) < 0.5 ? 0.25 * width : 0.005;
+      tool.depth_m = 0.002 + 0.02 * u(rng);
+      uncut += footprint_width < 0.95 * quarter;
+      Stroke s;
+      for (int w = 0; w < 2 + static_cast<int>(u(rng) * 3); ++w)
+        s.path_m.emplace_back(-0.01 + 0.32 * u(rng), -0.01 + 0.32 * u(rng));
+      s.spacing_m = 0.0005 + 0.004 * u(rng);
+      const HeightField field = HeightField::from_scene(run.scene);
+      const StampSchedule schedule = make_schedule(tool, s, [&field](const Vec2& p) { return field(p); });
+      for (std::size_t k = 0; k < schedule.stamps.size() && k < 40; ++k)
+        ASSERT_TRUE(run.step(schedule.stamps[k])) << "seed " << seed << " stroke " << stroke;
+    }
+    EXPECT_GE(uncut, 2u) << "seed " << seed;
+    double tracked = run.terrain->volume();
+    for (int pass = 0; pass < 4000 && run.terrain->stats().active > 0; pass += 64)
+      tracked += run.terrain->erode(run.rule, ErosionBudget{.max_passes = 64, .settling = true}).volume_change_m3;
+    EXPECT_EQ(run.terrain->stats().active, 0u) << "settled";
+    EXPECT_EQ(run.terrain->stats().constrained_edges, 0u);
+    EXPECT_TRUE(run.ok("settling", tracked));
+    EXPECT_NEAR(run.terrain->volume() - run.volume_added, v0, 1e-11 * v0);
+  }
+}
+
 TEST(TinStress, RandomStrokes) {
   for (std::uint64_t seed : {1u, 2u, 3u}) {
     std::mt19937_64 rng(seed);
