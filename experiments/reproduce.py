@@ -203,20 +203,35 @@ notes); the tables below are this run's.
   exactly on it by locating the middle, a walk from the last edit, often far along the spike: **our
   code**, fixed (an exact orientation test; the spike's walk steps 119,641 -> 39,712, its erosion
   7.5 -> 6.5 ms and settling 4.2 -> 2.8 ms in single runs, the cliff ratio 12.4x -> 11.2x; the shipped
-  scenes have no such edges and run the same). A footprint narrower than the mesh resolves was **our
+  scenes have no such edges and run the same). The settling after the stroke kept the last stamp's
+  constraints and its contours' O and I pairs, a contour gap apart, whose areas far below their
+  neighbours' throttled the last passes (a spike: ten rounds of 64 passes over about 20 vertices,
+  6 um a visit): **our code**, fixed: with no tool the last stamp has passed too (constraints dropped,
+  contours thinned), the spikes' settling 35,212 -> 9,234 and 29,887 -> 9,341 updates, the other
+  strokes' 7-32 % fewer (72 % at a 5-degree angle; trench walls within 0.05 degree of before), and the
+  spikes 11.0-11.3x -> 10.0-10.4x the grid's time (interleaved medians of 5 to 7; with two cheaper
+  steps of the stamp's bookkeeping, -5 % of its instructions). Linking tcmalloc (Debian's gperftools)
+  took them to 9.8x, the trench and `flat_stroke.toml` 3 % faster and the pile 1-3 % slower: not kept
+  for so little. A footprint narrower than the mesh resolves was **our
   code**, fixed: a 0.4 mm box was cut into a mesh of 7 mm edges as a hole a hundred times deeper than
   wide, which erosion then filled (58x the grid's time). A footprint narrower than a quarter of
   `tin.refine_m` (4 area / perimeter) now lowers the vertices it covers, as the grid lowers its nodes
   (here none: 0.4x). Measured against the same stroke on a 0.1 mm grid (its surface ends within 0.34 mm
-  of flat), the cut box erred 83 um rms where the flat sand left now errs 9 um (the 5 mm grid: 94 um);
-  a 1.7 mm box: 122 against 55 (151). The ratios that stay above 10x are tools the grid's 5 mm cells
+  of flat; rms over the 15 cm square around the stroke, rasters of 0.5 mm), the cut box erred 61 um
+  where the flat sand left now errs 6 um (the 5 mm grid: 69 um); a 1.7 mm box: 89 against 40 (111). The ratios that stay above 10x are tools the grid's 5 mm cells
   barely see (a 2 mm box, the narrowest the TIN cuts in, the blade's 10 mm, the spikes' thin ends): there
   the grid moves almost no sand while the TIN cuts the footprint, which is **the method** (the TIN models
-  what the grid cannot), not a cost to cut. Noticed on the way, not pursued: at the default 1 mm
-  tolerance neither back-end models such a stroke closely. Against the 0.1 mm grid, cut boxes of 3 to 12
-  mm err 192-790 um rms on the TIN and 224-596 on the 5 mm grid, more than leaving the sand flat would
-  (92-568), and the paper's 2 cm disk 1233 um on the TIN, 1409 on the grid (flat: 2385; single runs of
-  `flat_stroke.toml` with `output.raster_m = 0.0005`): the grooves and rims are a few millimetres wide.
+  what the grid cannot), not a cost to cut. Of a spike's stamp (callgrind) a quarter goes to dropping the
+  last stamp's constraints and thinning its contours, a fifth to inserting the new contours, an eighth
+  each to constraining them and to the rim's deposit; CGAL's vertex removals (the thinning's and step
+  1e's) are a fifth of it, memory allocation (mostly CGAL's) about a sixth. Moving the band's removals
+  before the insertions saved 1.5 % of it and changed the surfaces, so it was not kept. Noticed on the
+  way, not pursued: at the default 1 mm tolerance neither back-end models such a stroke closely. Against
+  the 0.1 mm grid, cut boxes of 2 to 12 mm err 107-590 um rms on the TIN and 142-437 on the 5 mm grid,
+  more than leaving the sand flat would (47-417; a 4 mm box leaves a hump on the TIN where the fine grid
+  has a groove 1.4 mm deep), and the paper's 2 cm disk 1231 um on the TIN, 1409 on the grid (flat: 2385;
+  single runs of `flat_stroke.toml` with `output.raster_m = 0.0005`): the grooves and rims are a few
+  millimetres wide, below both meshes' resolution.
 - **TIN pile with the default (gradient) rule**: was **our code**, fixed; what is left is the method at
   this resolution. The pile came out lobed (flank 26.8 degrees, roundness 0.075, RMSE 164 um, 4.7x the
   grid's) although the same sand relaxing from a 35-degree cone ended round: the flow, not the rest state

@@ -277,9 +277,9 @@ bool TinTerrain::plan_stamp(const ToolStamp& s, StampWork& w) {
 bool TinTerrain::resolves(const std::vector<Vec2>& footprint) const {
   // A 0.4 mm box on flat_stroke.toml (7 mm edges) was cut in as 8 vertices a hair apart and a
   // hole a hundred times deeper than wide, which erosion then filled on the coarse mesh: 58x
-  // the grid's time, and farther from a 0.1 mm grid's surface (83 um rms) than the flat sand
-  // it leaves uncut (9 um; a 1.7 mm box: 122 against 55 um, a 4 mm one, which is cut, 270
-  // against 129). A smaller tin.refine_m resolves such a tool.
+  // the grid's time, and farther from a 0.1 mm grid's surface (61 um rms around the stroke)
+  // than the flat sand it leaves uncut (6 um; a 1.7 mm box: 89 against 40 um, a 4 mm one,
+  // which is cut, 197 against 94). A smaller tin.refine_m resolves such a tool.
   return 4.0 * std::abs(signed_area(footprint)) >= kResolvedWidth * refine_m_ * perimeter(footprint);
 }
 
