@@ -573,12 +573,16 @@ std::vector<VertexHandle> TinTerrain::nearest_outside(const StampWork& w) {
   // size) often holds no vertex: the sand goes to the nearest ring of vertices outside the
   // footprint around the lowered ones (as the grid widens its band to the nearest nodes).
   std::vector<VertexHandle> frontier = w.changed, found;
-  if (frontier.empty()) {
-    const FaceHandle f = locate(clamp_to_domain(w.tool.pose.xy)).face;
-    for (int i = 0; i < 3; ++i)
-      if (!cdt_.is_infinite(f->vertex(i))) frontier.push_back(f->vertex(i));
-  }
   const std::uint32_t seen = next_vertex_epoch();
+  if (frontier.empty()) {  // nothing lowered (the deposit gives back old flips): from the pose's face
+    const FaceHandle f = locate(clamp_to_domain(w.tool.pose.xy)).face;
+    for (int i = 0; i < 3; ++i) {
+      const VertexHandle v = f->vertex(i);
+      if (cdt_.is_infinite(v)) continue;
+      v->info().mark = seen;
+      (w.in_footprint(xy(v)) ? frontier : found).push_back(v);
+    }
+  }
   for (VertexHandle v : frontier) v->info().mark = seen;
   while (found.empty() && !frontier.empty()) {  // each round a ring further out: ends
     std::vector<VertexHandle> next;
