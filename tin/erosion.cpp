@@ -214,11 +214,11 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
   };
   // Curvature refinement (tin.curvature_tolerance_m), unless it waits for the sand to settle.
   const bool creases = fine_m_ < refine_m_ && (budget.settling || spec_.curvature_while_stamping);
-  // Settling budgets: the cascade moves the sand far first (settle_region.cpp), the passes finish.
   // No tool: the last stamp has passed too. Its O and I pairs, a contour gap apart, had areas
   // far below their neighbours' and throttled the settling's last passes (a 0.2 m spike on
   // flat_stroke.toml: 35,212 settling updates, 9,234 once released).
   if (budget.settling) release_passed_stamps();
+  // Settling budgets: the cascade moves the sand far first (settle_region.cpp), the passes finish.
   settle_with_cascade(rule, budget, report);
   for (int pass = report.passes;
        pass < budget.max_passes && !erosion_list_.empty() && report.updates < budget.max_updates; ++pass) {

@@ -85,6 +85,30 @@ struct Runner {
     pose.heading_rad = heading;
     return make_stamp(tool, pose, Vec2(std::cos(heading), std::sin(heading)), 0);
   }
+  // A random polyline of 2 to 4 points in [lo, lo + span]^2 at a spacing in [spacing,
+  // spacing + spacing_span], stamped with `tool` (at most max_stamps); false on a problem.
+  bool random_stroke(const ToolSpec& tool, std::mt19937_64& rng, double lo, double span, double spacing,
+                     double spacing_span, std::size_t max_stamps) {
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    Stroke s;
+    for (int w = 0; w < 2 + static_cast<int>(u(rng) * 3); ++w)
+      s.path_m.emplace_back(lo + span * u(rng), lo + span * u(rng));
+    s.spacing_m = spacing + spacing_span * u(rng);
+    const HeightField field = HeightField::from_scene(scene);
+    const StampSchedule schedule = make_schedule(tool, s, [&field](const Vec2& p) { return field(p); });
+    for (std::size_t k = 0; k < schedule.stamps.size() && k < max_stamps; ++k)
+      if (!step(schedule.stamps[k])) return false;
+    return true;
+  }
+  // Settling budgets of 64 passes until nothing is active (at most `max_passes`), check() and
+  // the reported volume changes after them; true when settled and sound.
+  bool settle(int max_passes) {
+    double tracked = terrain->volume();
+    for (int pass = 0; pass < max_passes && terrain->stats().active > 0; pass += 64)
+      tracked += terrain->erode(rule, ErosionBudget{.max_passes = 64, .settling = true}).volume_change_m3;
+    EXPECT_EQ(terrain->stats().active, 0u) << "settled";
+    return ok("settling", tracked) && terrain->stats().active == 0;
+  }
   StampSchedule schedule(const Stroke& stroke) const {
     const HeightField field = HeightField::from_scene(scene);
     return make_schedule(scene.tool, stroke, [field](const Vec2& p) { return field(p); });
@@ -268,11 +292,7 @@ path_m = [[0.05, 0.05]]
   // (Measured: 1408 passes. Before the border held like a constraint in split_edge, erosion split
   // edges running almost along the border into chains of slivers against it, and 40000 passes
   // left 504 vertices active, facets at 54 degrees.)
-  double tracked = run.terrain->volume();
-  for (int pass = 0; pass < 4000 && run.terrain->stats().active > 0; pass += 64)
-    tracked += run.terrain->erode(run.rule, ErosionBudget{.max_passes = 64, .settling = true}).volume_change_m3;
-  EXPECT_EQ(run.terrain->stats().active, 0u) << "settled";
-  EXPECT_TRUE(run.ok("settling", tracked));
+  EXPECT_TRUE(run.settle(4000));
   EXPECT_NEAR(run.terrain->volume(), v0, 1e-11 * v0);
 }
 
@@ -305,22 +325,12 @@ TEST(TinStress, ToolsNarrowerThanTheMeshAmongCutOnes) {
       tool.rim.width_m = u(rng) < 0.5 ? 0.25 * width : 0.005;
       tool.depth_m = 0.002 + 0.02 * u(rng);
       uncut += footprint_width < 0.95 * quarter;
-      Stroke s;
-      for (int w = 0; w < 2 + static_cast<int>(u(rng) * 3); ++w)
-        s.path_m.emplace_back(-0.01 + 0.32 * u(rng), -0.01 + 0.32 * u(rng));
-      s.spacing_m = 0.0005 + 0.004 * u(rng);
-      const HeightField field = HeightField::from_scene(run.scene);
-      const StampSchedule schedule = make_schedule(tool, s, [&field](const Vec2& p) { return field(p); });
-      for (std::size_t k = 0; k < schedule.stamps.size() && k < 40; ++k)
-        ASSERT_TRUE(run.step(schedule.stamps[k])) << "seed " << seed << " stroke " << stroke;
+      ASSERT_TRUE(run.random_stroke(tool, rng, -0.01, 0.32, 0.0005, 0.004, 40))
+          << "seed " << seed << " stroke " << stroke;
     }
     EXPECT_GE(uncut, 2u) << "seed " << seed;
-    double tracked = run.terrain->volume();
-    for (int pass = 0; pass < 4000 && run.terrain->stats().active > 0; pass += 64)
-      tracked += run.terrain->erode(run.rule, ErosionBudget{.max_passes = 64, .settling = true}).volume_change_m3;
-    EXPECT_EQ(run.terrain->stats().active, 0u) << "settled";
+    EXPECT_TRUE(run.settle(4000));
     EXPECT_EQ(run.terrain->stats().constrained_edges, 0u);
-    EXPECT_TRUE(run.ok("settling", tracked));
     EXPECT_NEAR(run.terrain->volume() - run.volume_added, v0, 1e-11 * v0);
   }
 }
@@ -365,15 +375,9 @@ TEST(TinStress, RandomStrokes) {
       tool.rim.width_m = 0.002 + 0.02 * u(rng);
       tool.rim.forward_bias = u(rng);
       tool.depth_m = -0.005 + 0.02 * u(rng);  // sometimes above the surface
-      Stroke s;
       // Random polylines, reaching over the border now and then.
-      for (int w = 0; w < 2 + static_cast<int>(u(rng) * 3); ++w)
-        s.path_m.emplace_back(-0.02 + 0.34 * u(rng), -0.02 + 0.34 * u(rng));
-      s.spacing_m = 0.002 + 0.01 * u(rng);
-      const HeightField field = HeightField::from_scene(run.scene);
-      const StampSchedule schedule = make_schedule(tool, s, [&field](const Vec2& p) { return field(p); });
-      for (std::size_t k = 0; k < schedule.stamps.size() && k < 30; ++k)
-        ASSERT_TRUE(run.step(schedule.stamps[k])) << "seed " << seed << " stroke " << stroke;
+      ASSERT_TRUE(run.random_stroke(tool, rng, -0.02, 0.34, 0.002, 0.01, 30))
+          << "seed " << seed << " stroke " << stroke;
     }
     const double drift = run.terrain->volume() - v0 - run.volume_added;
     if (seed == 3)
