@@ -63,14 +63,19 @@ def package_version(name):
 def machine_header(ctx):
     """The binary, the runs behind the numbers and the machine. Stable when nothing reran (no
     date of today, no commit of HEAD), so a second reproduction leaves REPORT.md as it was."""
-    cpu = "unknown"
+    cpu, flags = "unknown", set()
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
+            if line.startswith("model name") and cpu == "unknown":
                 cpu = line.split(":", 1)[1].strip()
-                break
+            elif line.startswith("flags") and not flags:
+                flags = set(line.split(":", 1)[1].split())
     except OSError:
         pass
+    # The grid kernel's lanes follow the CPU (grid/erosion_kernel.hpp, has_avx512 / has_avx2), and
+    # with them the grid's times: eight nodes at once with AVX-512, four with AVX2.
+    lanes = ("AVX-512" if {"avx512f", "avx512vl", "avx512dq", "avx512bw"} <= flags
+             else "AVX2" if "avx2" in flags else "SSE2")
     compiler = subprocess.run(["c++", "--version"], capture_output=True, text=True).stdout.splitlines()[0]
     libs = ", ".join(f"{n} {package_version(p)}" for n, p in
                      [("CGAL", "libcgal-dev"), ("Eigen", "libeigen3-dev"), ("HDF5", "libhdf5-dev"),
@@ -83,7 +88,8 @@ def machine_header(ctx):
             f"finished {dates[0]}..{dates[-1]}\n" if sides else "")
     return (f"- profile: {ctx.profile_name}\n"
             f"- binary: {ctx.binary['version']}; compiler {compiler}\n" + runs +
-            f"- machine: {platform.machine()}, {cpu}, {len(os.sched_getaffinity(0))} cores; {platform.platform()}\n"
+            f"- machine: {platform.machine()}, {cpu}, {len(os.sched_getaffinity(0))} cores, the grid kernel in {lanes} "
+            f"lanes; {platform.platform()}\n"
             f"- libraries: {libs}\n")
 
 

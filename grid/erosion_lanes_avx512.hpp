@@ -1,7 +1,7 @@
 #pragma once
 // The dense pass's AVX-512 paths (grid/erosion_kernel.hpp): a row classed eight nodes per
 // compare, and eight nodes of one phase (three columns apart) visited at once, one per lane,
-// with the edge or the gradient rule (the AVX2 lanes have the edge rule only).
+// with the edge or the gradient rule (as the AVX2 lanes do four at a time).
 // Compiled for AVX-512 by target attributes and called only where the CPU has it
 // (has_avx512()); the kernel falls back to its AVX2 and SSE2 paths elsewhere, with the same
 // results bit for bit (tests/unit/grid_dense_pass_test.cpp compares them).
