@@ -51,12 +51,18 @@ def sweeps(profile_name, case):
         tin += [(f"tin {sides[-1]}-gon subdiv 2 mm", "tin", [f"tool.sides={sides[-1]}",
                  f"tin.refine_m={0.99 * perimeter / sides[-1]:.6f}", "tin.contour_subdivision_m=0.002"])]
     if case != "crater":
-        tin += [(f"tin refine {r * 1000:g} mm" if r > 0 else "tin refine default", "tin", [f"tin.refine_m={r}"])
+        # pile.toml refines by curvature at rest (its [tin] section): on the pile every row sets
+        # its refinement itself, so that it is what its label says.
+        plain = ["tin.curvature_tolerance_m=0"] if case == "pile" else []
+        always = ["tin.curvature_when=always"] if case == "pile" else []
+        tin += [(f"tin refine {r * 1000:g} mm" if r > 0 else "tin refine default", "tin", [f"tin.refine_m={r}"] + plain)
                 for r in refine]
         # Refinement where facet gradients jump (the apex, the toe, a trench's edges), at the
         # default edge length elsewhere: the TIN's own way to spend vertices on accuracy.
         if profile_name != "tiny":
-            tin += [("tin curved 0.2 mm", "tin", ["tin.curvature_tolerance_m=0.0002"])]
+            tin += [("tin curved 0.2 mm", "tin", ["tin.curvature_tolerance_m=0.0002"] + always)]
+            if case == "pile":
+                tin += [("tin curved 0.5 mm at rest (pile.toml)", "tin", [])]
             # The same refinement only while the sand settles: the strokes' steps cost what
             # the default TIN's do, and the surface at rest gets the creases refined.
             tin += [("tin curved 0.2 mm at rest", "tin",

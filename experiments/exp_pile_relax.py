@@ -58,7 +58,8 @@ def run(ctx):
 
 The same 2e-5 m^3 of sand against the same analytic 30-degree cone: poured at a point (`pile.toml`, 20 pours,
 each landing as a 60 mm spike within 4 mm) or standing as a cone at 35, 45 or 60 degrees that relaxes
-(`cone.toml`). Default rule (gradient) and the paper's edge rule; default settings otherwise.
+(`cone.toml`). Default rule (gradient) and the paper's edge rule; each scene's settings otherwise (`pile.toml`
+refines the TIN by curvature where the sand has come to rest, `tin.curvature_tolerance_m = 0.0005`; `cone.toml` does not).
 
 ![pile_relax]({png})
 
