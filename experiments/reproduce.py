@@ -20,6 +20,7 @@ import engines
 import sbrun
 import exp_accuracy
 import exp_alpha_flat
+import exp_bars
 import exp_cascade
 import exp_cliffs
 import exp_drift
@@ -51,6 +52,7 @@ EXPERIMENTS = {
     "cascade": exp_cascade,
     "stability": exp_stability,
     "cliffs": exp_cliffs,
+    "bars": exp_bars,
     "haptics": exp_haptics,
 }
 
@@ -145,7 +147,8 @@ notes); the tables below are this run's.
   were measured where the grid runs in AVX-512 lanes (an EPYC of the Zen 4 kind), unless they say
   otherwise; on an EPYC without AVX-512 (AVX2 lanes, four at a time) the grid's steps take about 2.8x as
   long on the pile and 1.7x on the trench, the TIN's 1.4-1.6x, so every TIN / grid time ratio is
-  smaller there. Until this round the gradient rule, the scenes' default, ran in AVX2 lanes not at all
+  smaller there; the bars table below measures the pile's and the trench's bars on this run's machine.
+  Until this round the gradient rule, the scenes' default, ran in AVX2 lanes not at all
   but one node at a time: **our code** (the grid below its own limit on such CPUs), fixed: four at a
   time, bit for bit the scalar visits (`grid_bench`: pile 14 -> 26 M updates/s, stroke 19 -> 44; the
   grid's step on `pile.toml` 0.186 -> 0.141 ms, `trench.toml` 0.310 -> 0.170, `flat_stroke.toml`
@@ -159,8 +162,8 @@ notes); the tables below are this run's.
   trench step fell from 1.24 ms three rounds ago to 0.79 ms; the grid's, brought to its own limit, from
   0.24 to 0.10 ms, so the ratio is 7.8-8.1x (interleaved medians, 7 rounds, at the start and the end of
   the last round, whose grid kernel got faster and whose TIN work went to settling and to the cliffs). Where the grid runs in
-  AVX2 lanes (this run's machine), 4.8-5.3x (interleaved medians of 7 and 9 rounds, with the gradient rule
-  in those lanes). Where it goes: the TIN needs
+  AVX2 lanes, 4.8-5.6x (interleaved medians of 7 and 9 rounds, with the gradient rule in those lanes;
+  the bars table has this run's): above the bar of 5x by about a tenth there, by 60 % with AVX-512. Where it goes: the TIN needs
   fewer erosion updates than the grid during the stroke (0.43x on the trench, 0.62x on the pile: the
   method's advantage, fewer elements), but one update costs 6-14x the grid's (about 100 ns on a settled
   mesh, 130-240 ns during a stroke with its splits, against 14-28 ns for the grid's eight-lane visits), and
@@ -322,9 +325,9 @@ notes); the tables below are this run's.
   (1.49x without; the pile positions table; at 0.0003 in single runs 1.18x, but settling 5.7x). With
   the paper's edge rule it does not help (the regression golden's pile: 70.8 -> 72.5 um, flank
   30.70 -> 31.22 degrees). The pile's bars (RMSE <= 1.25x, memory <= 1x, settling <= 10x, step <= 3x
-  the grid's) then hold together where the grid runs in AVX2 lanes, as in this run (step 2.6-3.2x in
-  three interleaved runs of 7 to 9 rounds on a noisy machine: at the bar), not where it runs in AVX-512
-  lanes (3.8x): the step is the method's cost per visit against the grid's vector lanes (above); the
+  the grid's) then hold together where the grid runs in AVX2 lanes (the bars table; during development
+  the step 2.2-3.2x in four interleaved runs of 7 to 9 rounds on a noisy machine, single rounds 1.7-4.0x:
+  at the bar), not where it runs in AVX-512 lanes (3.8x): the step is the method's cost per visit against the grid's vector lanes (above); the
   error is the TIN's own refinement at rest.
 - **TIN on a narrow domain** (found by running the shipped scenes on random domains): was **our code**,
   fixed. A pile poured on a 0.3 x 0.01 m strip never settled on the TIN (facets at 88 degrees after

@@ -36,7 +36,7 @@ PROFILES = {
     "tiny": {"fig7_n": [300, 1000], "trace": [0.1, 0.3], "fig8_n": 1000, "memory_cells": [0.02, 0.01],
              "reference_cell": 0.005, "alpha": [0.0, 0.4, 4.0], "drift_repeat": 1,
              "settle_cells": [0.01, 0.005], "stability_cases": ["crossing", "utm_offset", "nan_value"],
-             "cliffs": ["sides_4096", "angle_5"], "cliff_repeats": 1},
+             "cliffs": ["sides_4096", "angle_5"], "cliff_repeats": 1, "bar_repeats": 1},
     "paper": {"fig7_n": [1000, 2000, 4000, 6000, 8000, 10000], "trace": [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8,
               0.9, 1.0], "fig8_n": 10000, "memory_cells": [0.02, 0.01, 0.005, 0.0025, 0.00125],
               "reference_cell": 0.000625, "alpha": [0.0, 0.1, 0.2, 0.4, 0.8, 1.6, 3.2, 6.4], "drift_repeat": 3,

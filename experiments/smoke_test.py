@@ -22,7 +22,7 @@ FIGURES = ["fig5_tin_shaded.png", "fig5_tin_wireframe.png", "fig6_grid_shaded.pn
            "pile_relax.png", "cascade.png"]
 TABLES = ["fig7_time_vs_size", "fig8_time_vs_trace", "fig9_elements_vs_trace", "memory", "drift", "alpha_flat",
           "accuracy", "orientation_cases", "orientation_trench", "orientation_worst", "settling",
-          "pile_relax", "pile_positions", "cascade"]
+          "pile_relax", "pile_positions", "cascade", "bars"]
 
 
 def main():
