@@ -145,9 +145,9 @@ notes); the tables below are this run's.
 - **Which machine**: the ratios move with the CPU, because the grid's kernel runs its visits in the widest
   lanes the CPU has (the header above names them) and the TIN's visits are scalar. The judgements below
   were measured where the grid runs in AVX-512 lanes (an EPYC of the Zen 4 kind), unless they say
-  otherwise; on an EPYC without AVX-512 (AVX2 lanes, four at a time) the grid's steps take about 2.8x as
-  long on the pile and 1.7x on the trench, the TIN's 1.4-1.6x, so every TIN / grid time ratio is
-  smaller there; the bars table below measures the pile's and the trench's bars on this run's machine.
+  otherwise; on an EPYC without AVX-512 (AVX2 lanes, four at a time) the grid's steps take 2-2.8x as
+  long on the pile and 1.7-2.4x on the trench, the TIN's 1.2-2x (medians of different sessions on the
+  two machines, so rough), so every TIN / grid time ratio is smaller there; the bars table below measures the pile's and the trench's bars on this run's machine.
   Until this round the gradient rule, the scenes' default, ran in AVX2 lanes not at all
   but one node at a time: **our code** (the grid below its own limit on such CPUs), fixed: four at a
   time, bit for bit the scalar visits (`grid_bench`: pile 14 -> 26 M updates/s, stroke 19 -> 44; the
