@@ -53,7 +53,7 @@ def sweeps(profile_name, case):
     if case != "crater":
         # pile.toml refines by curvature at rest (its [tin] section): on the pile every row sets
         # its refinement itself, so that it is what its label says.
-        plain = ["tin.curvature_tolerance_m=0"] if case == "pile" else []
+        plain = [sbrun.NO_CURVATURE] if case == "pile" else []
         always = ["tin.curvature_when=always"] if case == "pile" else []
         tin += [(f"tin refine {r * 1000:g} mm" if r > 0 else "tin refine default", "tin", [f"tin.refine_m={r}"] + plain)
                 for r in refine]

@@ -19,11 +19,10 @@ def cases(profile_name):
     out = [("poured pile", "pile.toml", "grid", f"{c * 1e3:g} mm cells", [f"grid.cell_m={c}"])
            for c in GRID_CELLS[profile_name]]
     # Without pile.toml's curvature refinement at rest, with which the TIN's cascade stands aside.
-    plain = "tin.curvature_tolerance_m=0"
-    out += [("poured pile", "pile.toml", "tin", f"{n} initial points", [f"tin.initial_points={n}", plain])
+    out += [("poured pile", "pile.toml", "tin", f"{n} initial points", [f"tin.initial_points={n}", sbrun.NO_CURVATURE])
             for n in TIN_POINTS[profile_name]]
     if profile_name != "tiny":  # refined where the sand flows only, to 2 mm
-        out.append(("poured pile", "pile.toml", "tin", "refined to 2 mm", ["tin.refine_m=0.002", plain]))
+        out.append(("poured pile", "pile.toml", "tin", "refined to 2 mm", ["tin.refine_m=0.002", sbrun.NO_CURVATURE]))
     out += [("deep stroke", "flat_stroke.toml", backend, "scene's", DEEP) for backend in ("grid", "tin")]
     return out
 

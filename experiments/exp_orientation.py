@@ -80,7 +80,7 @@ def job(case, az, cfg, rule):
     scene = "pile.toml" if case == "pile" else CASES[case][0]
     backend, extra = CONFIGS[cfg]
     if case == "pile" and backend == "tin":  # without pile.toml's own curvature refinement at rest
-        extra = extra + (["tin.curvature_when=always"] if cfg == CURVED else ["tin.curvature_tolerance_m=0"])
+        extra = extra + (["tin.curvature_when=always"] if cfg == CURVED else [sbrun.NO_CURVATURE])
     name = f"orientation/{case}-{az:g}-{cfg.replace(' ', '_').replace('-', '')}-{rule}"
     return (sbrun.SCENES / scene, backend, name, extra + turned(case, az) + [f"erosion.rule={rule}"])
 

@@ -33,7 +33,7 @@ def positions(count):
 COUNT = {"tiny": 3, "paper": 8, "full": 16}
 # (label, backend, overrides): each back-end as the scene asks, and the TIN without the scene's
 # curvature refinement at rest (its [tin] section) for what that refinement buys.
-MODELS = [("grid", "grid", []), ("tin", "tin", []), ("tin plain", "tin", ["tin.curvature_tolerance_m=0"])]
+MODELS = [("grid", "grid", []), ("tin", "tin", []), ("tin plain", "tin", [sbrun.NO_CURVATURE])]
 
 
 def run(ctx):
@@ -44,9 +44,10 @@ def run(ctx):
     s = ctx.run_many("pile_positions", jobs)
     rows, rmse = [], {label: [] for label, _, _ in MODELS}
     for k, (x, y) in enumerate(points):
-        grid, tin, plain = s[len(MODELS) * k:len(MODELS) * (k + 1)]
-        for label, r in (("grid", grid), ("tin", tin), ("tin plain", plain)):
+        runs = s[len(MODELS) * k:len(MODELS) * (k + 1)]
+        for (label, _, _), r in zip(MODELS, runs):
             rmse[label].append(r["reference.rmse_m"] * 1e6)
+        grid, tin, plain = runs
         rows.append([f"({x:.4f}, {y:.4f})" + (" (the scene's)" if k == 0 else ""), grid["reference.rmse_m"] * 1e6,
                      grid["pile.flank_angle_deg"], grid["pile.roundness"], tin["reference.rmse_m"] * 1e6,
                      tin["pile.flank_angle_deg"], tin["pile.roundness"], tin["reference.rmse_m"] / grid["reference.rmse_m"],

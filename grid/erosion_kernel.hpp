@@ -105,11 +105,11 @@
 // (dense_pass's bands at once; medians of 7 in two runs, the lower with another job on the
 // machine: 1.7-1.8x one thread's 191-193, about the same CPU time, 21-22x the scalar sweep);
 // float 51 (49), 70 (67), 99 (95); the
-// gradient rule (AVX-512 lanes), double: 70 on the pile
-// and 101 on the stroke (66, 97). On an EPYC without AVX-512 (AVX2 lanes, the same bench,
-// medians of 3 interleaved runs), the gradient rule four nodes at a time: 26 on the pile and
-// 44 on the stroke, against 14 and 19 visiting it one node at a time as before. Measured in the AVX2 lanes (callgrind,
-// which runs no AVX-512; the instructions of erode_ordered per update, unchanged by that build), double / float:
+// gradient rule (AVX-512 lanes), double: 70 on the pile and 101 on the stroke (66, 97). On an
+// EPYC without AVX-512 (AVX2 lanes, the same bench, medians of 3 interleaved runs), the
+// gradient rule four nodes at a time: 26 on the pile and 44 on the stroke, against 14 and 19
+// visiting it one node at a time as before. Measured in the AVX2 lanes (callgrind, which runs
+// no AVX-512; the instructions of erode_ordered per update, unchanged by that build), double / float:
 // grid_bench's pile 180 / 227, its stroke 126 / 169. Four visits in AVX2 lanes take ~320
 // instructions (double); classing a row ~16 per node (AVX2, double; ~29 float); rebuilding the
 // active set after a dense pass ~8 per node of the visited columns. Active-set visits add ~100

@@ -118,9 +118,7 @@ bool TinTerrain::middle_on_edge(VertexHandle v, VertexHandle w) const {
   return cdt_.geom_traits().orientation_2_object()(v->point(), w->point(), Point(m.x(), m.y(), 0.0)) == CGAL::COLLINEAR;
 }
 
-std::size_t TinTerrain::refine_around(VertexHandle v) {
-  // has_long_edges' cached answer, read here: erosion asks for every transfer.
-  if (v->info().short_edges) return 0;
+std::size_t TinTerrain::split_long_edges(VertexHandle v) {
   std::size_t splits = 0;
   const double crowded2 = kCrowdedSplit * kCrowdedSplit * refine_m_ * refine_m_;
   for (int guard = 0; guard < 64 && has_long_edges(v); ++guard) {
@@ -234,12 +232,10 @@ ErosionReport TinTerrain::erode(const ErosionRule& given, const ErosionBudget& b
           erosion_transfers(v->point().z(), area, gradient_at(v), nbrs(), rule, transfers(), NeighbourLayout::Fan);
       // Sand moving between vertices with long edges would spread over far-reaching
       // triangles: refine the stars of the giver and the receivers first, then recompute.
-      // (Stars known to be short skip the call: most are, and the call is a twentieth of a visit.)
       for (int round = 0; round < 3 && total > 0.0; ++round) {
-        std::size_t splits = v->info().short_edges ? 0 : refine_around(v);
+        std::size_t splits = refine_around(v);
         for (std::size_t k = 0; k < ring_n_; ++k)
-          if (transfer_scratch_[k] > 0.0 && !vertex_scratch_[k]->info().short_edges)
-            splits += refine_around(vertex_scratch_[k]);
+          if (transfer_scratch_[k] > 0.0) splits += refine_around(vertex_scratch_[k]);
         if (splits == 0 && creases && refine_crease(v)) splits = 1;
         if (splits == 0) break;
         area = gather_neighbours(v);
