@@ -267,6 +267,9 @@ class TinTerrain final : public Terrain {
   void constrain_contours(const StampWork& w);               // 1b, 1c
   void lower_to_tool(StampWork& w);                          // 1d
   void remove_redundant(StampWork& w, StampReport& report);  // 1e
+  // Of 1e's redundant vertices (in position order), those that resolve the floor at half
+  // refine_m_ are taken out of the list (kept in the mesh). O(their stars).
+  void keep_resolving_vertices(std::vector<VertexHandle>& redundant);
   // 1d (cont.): `deposit` spread over the rim band; returns what was deposited.
   double deposit_on_rim(StampWork& w, double deposit, StampReport& report);
   // 1f: the vertices whose heights changed join L_e with their neighbours, and L_r; of the
