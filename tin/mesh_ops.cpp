@@ -262,9 +262,70 @@ void TinTerrain::remove_vertex(VertexHandle v) {
   do {
     if (!cdt_.is_infinite(c)) link_scratch_.push_back(c);
   } while (++c != done);
-  cdt_.remove(v);
+  if (link_scratch_.size() == cdt_.degree(v))
+    remove_by_flips(v);
+  else
+    cdt_.remove(v);  // a vertex on the hull
   // The hole is retriangulated from its boundary, the removed vertex's neighbours.
   for (VertexHandle w : link_scratch_) forget_caches(w);
+}
+
+void TinTerrain::remove_by_flips(VertexHandle v) {
+  // Removal by flips: an edge (v, w) whose two faces form a strictly convex
+  // quadrilateral is flipped to the quadrilateral's other diagonal (a, b), which takes one
+  // neighbour from v; the link of an interior vertex is star-shaped around it, so some edge
+  // qualifies until 3 are left, and the last triangle is merged. Lawson flips from the
+  // diagonals then restore the (perturbed, so unique) Delaunay triangulation CGAL's hole
+  // filling builds, without its lists (an allocation per edge): measured with callgrind on
+  // trench.toml's stroke, about 2,200 removals at 7.5k -> 4.2k instructions each.
+  const auto orientation = cdt_.geom_traits().orientation_2_object();
+  auto& diagonals = diagonal_scratch_;
+  diagonals.clear();
+  std::size_t degree = link_scratch_.size();
+  while (degree > 3) {
+    const FaceHandle start = v->face();
+    FaceHandle f = start;
+    bool flipped = false;
+    do {
+      const int iv = f->index(v), j = Cdt::ccw(iv);
+      // Edge j of f joins v and w; a faces it in f, b in the neighbour.
+      const FaceHandle g = f->neighbor(j);
+      const VertexHandle w = f->vertex(Cdt::cw(iv)), a = f->vertex(j), b = g->vertex(cdt_.mirror_index(f, j));
+      const auto side_v = orientation(a->point(), b->point(), v->point());
+      const auto side_w = orientation(a->point(), b->point(), w->point());
+      if (side_v != CGAL::COLLINEAR && side_w != CGAL::COLLINEAR && side_v != side_w) {
+        FaceHandle flip_face = f;
+        cdt_.flip(flip_face, j);
+        diagonals.emplace_back(a, b);
+        --degree;
+        flipped = true;
+        break;
+      }
+      f = f->neighbor(Cdt::ccw(f->index(v)));
+    } while (f != start);
+    if (!flipped) break;  // (collinear neighbours: CGAL's hole filling finishes)
+  }
+  if (degree > 3) {
+    cdt_.remove(v);
+  } else {
+    // Degree 3: the merged face keeps the outer faces' constraint marks on its edges.
+    const FaceHandle merged = v->face();
+    cdt_.tds().remove_degree_3(v, merged);
+    for (int i = 0; i < 3; ++i)
+      merged->set_constraint(i, merged->neighbor(i)->is_constrained(cdt_.mirror_index(merged, i)));
+  }
+  // Lawson: a flipped edge's quadrilateral sides are checked in turn (CGAL's propagating_flip
+  // checks only the two facing an inserted vertex).
+  while (!diagonals.empty()) {
+    const auto [a, b] = diagonals.back();
+    diagonals.pop_back();
+    FaceHandle f;
+    int i = 0;
+    if (!cdt_.is_edge(a, b, f, i) || !cdt_.is_flipable(f, i)) continue;
+    const VertexHandle c = f->vertex(i), d = f->neighbor(i)->vertex(cdt_.mirror_index(f, i));
+    cdt_.flip(f, i);
+    diagonals.insert(diagonals.end(), {{a, c}, {c, b}, {b, d}, {d, a}});
+  }
 }
 
 void TinTerrain::constrain(VertexHandle a, VertexHandle b, std::uint32_t generation) {

@@ -186,6 +186,9 @@ class TinTerrain final : public Terrain {
   void conflict_region(const Point& q, const Location& loc, double& volume, double& area, double& extent2);
   // Removes an unconstrained, non-border vertex, keeping the lists and the hint valid.
   void remove_vertex(VertexHandle v);
+  // remove_vertex for an interior vertex (link_scratch_: its neighbours, all finite): by
+  // flips, with CGAL's removal finishing where its neighbours are collinear. O(degree^2).
+  void remove_by_flips(VertexHandle v);
   void constrain(VertexHandle a, VertexHandle b, std::uint32_t generation);
   void unconstrain(VertexHandle a, VertexHandle b);
   // Gives every constrained edge without a generation record this generation. O(n).
@@ -392,12 +395,13 @@ class TinTerrain final : public Terrain {
   std::vector<VertexHandle> vertex_scratch_;
   std::vector<FaceHandle> face_scratch_;
   std::vector<VertexHandle> link_scratch_;
-  std::vector<VertexHandle> work_scratch_;       // erosion: the pass's copy of L_e
-  std::vector<VertexHandle> redundant_scratch_;  // simplify: vertices to remove
-  std::vector<VertexHandle> link_hold_scratch_;  // simplify: the removed vertex's link
-  std::vector<double> link_z_scratch_;           // simplify: the link's heights before the give-back
-  std::vector<double> link_area_scratch_;        // simplify: the link's areas before the removal
-  std::vector<VertexHandle> ring_scratch_;       // ring_of: the walk before it is cached
+  std::vector<std::pair<VertexHandle, VertexHandle>> diagonal_scratch_;  // remove_by_flips
+  std::vector<VertexHandle> work_scratch_;                               // erosion: the pass's copy of L_e
+  std::vector<VertexHandle> redundant_scratch_;                          // simplify: vertices to remove
+  std::vector<VertexHandle> link_hold_scratch_;                          // simplify: the removed vertex's link
+  std::vector<double> link_z_scratch_;      // simplify: the link's heights before the give-back
+  std::vector<double> link_area_scratch_;   // simplify: the link's areas before the removal
+  std::vector<VertexHandle> ring_scratch_;  // ring_of: the walk before it is cached
 };
 
 // Area of a finite face projected on the xy plane (positive: faces are counter-clockwise).
