@@ -63,7 +63,8 @@ ModelStats TinTerrain::stats() const {
   bytes += vector_bytes(erosion_list_) + vector_bytes(simplify_list_) + vector_bytes(nbr_scratch_) +
            vector_bytes(transfer_scratch_) + vector_bytes(vertex_scratch_) + vector_bytes(face_scratch_) +
            vector_bytes(link_scratch_) + vector_bytes(work_scratch_) + vector_bytes(redundant_scratch_) +
-           vector_bytes(link_hold_scratch_) + vector_bytes(ring_pool_) + vector_bytes(ring_scratch_);
+           vector_bytes(link_hold_scratch_) + vector_bytes(ring_pool_) + vector_bytes(ring_scratch_) +
+           vector_bytes(diagonal_scratch_) + vector_bytes(link_z_scratch_) + vector_bytes(link_area_scratch_);
   st.bytes = bytes;
   return st;
 }
