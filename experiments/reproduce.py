@@ -162,8 +162,18 @@ notes); the tables below are this run's.
   trench step fell from 1.24 ms three rounds ago to 0.79 ms; the grid's, brought to its own limit, from
   0.24 to 0.10 ms, so the ratio is 7.8-8.1x (interleaved medians, 7 rounds, at the start and the end of
   the last round, whose grid kernel got faster and whose TIN work went to settling and to the cliffs). Where the grid runs in
-  AVX2 lanes, 4.8-5.6x (interleaved medians of 7 and 9 rounds, with the gradient rule in those lanes;
-  the bars table has this run's): above the bar of 5x by about a tenth there, by 60 % with AVX-512. Where it goes: the TIN needs
+  AVX2 lanes, 4.8-5.6x (interleaved medians of 7 and 9 rounds, with the gradient rule in those lanes),
+  above the bar of 5x by about a tenth there, by 60 % with AVX-512. Two more causes in **our code**,
+  fixed this round: step 1e removed every vertex left at the tool's level, so the sand sliding in from
+  the walls split the floor's edges again (23 removals and 42 splits a step); it now keeps one wherever
+  none lies within half `tin.refine_m`. And CGAL's removal of a vertex fills the hole through lists
+  allocated edge by edge; an interior vertex is now removed by flips (to degree 3, then Lawson flips:
+  the same Delaunay mesh), 7.5k -> 4.2k instructions a removal. Together 14 % fewer instructions in the
+  strokes of `trench.toml`, `trench_azimuth.toml` at 4 azimuths and `flat_stroke.toml` (callgrind), the
+  TIN's trench step 1.06 -> 0.94 ms and the pile's 0.40 -> 0.36 ms (interleaved medians of 9 on the
+  AVX2 machine, the grid's 0.24-0.26 and 0.15 ms there): 3.7x on the trench where the grid runs in AVX2
+  lanes (4.0x in the reproduction that wrote this text; the bars table has this run's), about 7x with
+  AVX-512 (estimated from the previous 7.8-8.1x, not measured). Where it goes: the TIN needs
   fewer erosion updates than the grid during the stroke (0.43x on the trench, 0.62x on the pile: the
   method's advantage, fewer elements), but one update costs 6-14x the grid's (about 100 ns on a settled
   mesh, 130-240 ns during a stroke with its splits, against 14-28 ns for the grid's eight-lane visits), and
@@ -176,7 +186,9 @@ notes); the tables below are this run's.
   Re-activating only the giver's ring, as the grid re-activates only the giver's 3 x 3 block, was tried:
   steps 3-12 % faster, but the poured pile 47.6 -> 58.8 um and the trench's worst wall over 0-90 degrees
   0.45 -> 0.90 degrees from critical (medians of 5 interleaved runs): a receiver's neighbours read its
-  height in their fan gradients, so those visits are needed; not kept. Laying out each cached
+  height in their fan gradients, so those visits are needed; not kept (tried again this round, during
+  strokes only: 6 % fewer instructions in the strokes, the pile at its pour point 40.6 -> 47.7 um, 39.4
+  against 38.6 over eight pour points). Laying out each cached
   ring's cotangent weights and fan-gradient coefficients once per star (as the cascade's fine level does)
   was tried: 1,206 instructions a visit on the pile (its step 0.202 -> 0.185 ms, 9 interleaved rounds),
   but no gain on the trench or `flat_stroke.toml` (stamps re-walk the stars about every ten visits: 0.78 ->
@@ -230,8 +242,8 @@ notes); the tables below are this run's.
   6 um a visit): **our code**, fixed: with no tool the last stamp has passed too (constraints dropped,
   contours thinned), the spikes' settling 35,212 -> 9,234 and 29,887 -> 9,341 updates, the other
   strokes' 7-32 % fewer (72 % at a 5-degree angle; trench walls within 0.05 degree of before), and the
-  spikes 11.0-11.3x -> 10.0-10.4x the grid's time (7.3-9.9x where the grid runs in AVX2 lanes: the cliffs
-  table; interleaved medians of 5 to 7; with two cheaper
+  spikes 11.0-11.3x -> 10.0-10.4x the grid's time (7.3-9.9x where the grid runs in AVX2 lanes, 6.9-7.0x
+  with this round's step 1e and removal by flips: the cliffs table; interleaved medians of 5 to 7; with two cheaper
   steps of the stamp's bookkeeping, -5 % of its instructions). Linking tcmalloc (Debian's gperftools)
   took them to 9.8x, the trench and `flat_stroke.toml` 3 % faster and the pile 1-3 % slower: not kept
   for so little. A footprint narrower than the mesh resolves was **our
