@@ -169,9 +169,9 @@ notes); the tables below are this run's.
   none lies within half `tin.refine_m`. And CGAL's removal of a vertex fills the hole through lists
   allocated edge by edge; an interior vertex is now removed by flips (to degree 3, then Lawson flips:
   the same Delaunay mesh), 7.5k -> 4.2k instructions a removal. Together 14 % fewer instructions in the
-  strokes of `trench.toml`, `trench_azimuth.toml` at 4 azimuths and `flat_stroke.toml` (callgrind), the
-  TIN's trench step 1.06 -> 0.94 ms and the pile's 0.40 -> 0.36 ms (interleaved medians of 9 on the
-  AVX2 machine, the grid's 0.24-0.26 and 0.15 ms there): 3.7x on the trench where the grid runs in AVX2
+  strokes of `trench.toml`, `trench_azimuth.toml` at 4 azimuths and `flat_stroke.toml` (callgrind; the
+  pile's pours, which remove almost nothing, the same work), the TIN's trench step 1.06 -> 0.94 ms
+  (interleaved medians of 9 on the AVX2 machine, the grid's 0.24-0.26 ms there): 3.7x where the grid runs in AVX2
   lanes (4.0x in the reproduction that wrote this text; the bars table has this run's), about 7x with
   AVX-512 (estimated from the previous 7.8-8.1x, not measured). Where it goes: the TIN needs
   fewer erosion updates than the grid during the stroke (0.43x on the trench, 0.62x on the pile: the
