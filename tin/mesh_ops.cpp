@@ -258,14 +258,18 @@ void TinTerrain::remove_vertex(VertexHandle v) {
     } while (++c != done);
   }
   link_scratch_.clear();
+  bool on_hull = false;
   auto c = cdt_.incident_vertices(v), done = c;
   do {
-    if (!cdt_.is_infinite(c)) link_scratch_.push_back(c);
+    if (cdt_.is_infinite(c))
+      on_hull = true;
+    else
+      link_scratch_.push_back(c);
   } while (++c != done);
-  if (link_scratch_.size() == cdt_.degree(v))
-    remove_by_flips(v);
+  if (on_hull)
+    cdt_.remove(v);
   else
-    cdt_.remove(v);  // a vertex on the hull
+    remove_by_flips(v);
   // The hole is retriangulated from its boundary, the removed vertex's neighbours.
   for (VertexHandle w : link_scratch_) forget_caches(w);
 }
