@@ -10,7 +10,7 @@ FULL ?= 0
 
 FUZZ_SECONDS ?= 60
 
-.PHONY: all deps configure build test test-asan reproduce bench goldens fuzz format format-check lint clean
+.PHONY: all deps configure build test test-asan reproduce dem bench goldens fuzz format format-check lint clean
 
 all: build
 
@@ -42,6 +42,17 @@ reproduce: build
 		$(if $(SLURM_PARTITION),--partition $(SLURM_PARTITION),) $(if $(SLURM_ACCOUNT),--account $(SLURM_ACCOUNT),) \
 		$(if $(SLURM_TIME),--time $(SLURM_TIME),) $(if $(SLURM_MEM),--mem $(SLURM_MEM),) \
 		--parallel $(SLURM_PARALLEL) --batch $(SLURM_BATCH) $(foreach a,$(SLURM_ARGS),--sbatch-arg=$(a))
+
+# The particle (DEM) references in experiments/dem/references/, regenerated from the scenes with
+# LAMMPS (installed by deps.sh): every case x seed of experiments/dem/{cases,material}.toml.
+# ENGINE=slurm runs them as one job array (SLURM_PARTITION, SLURM_TIME as for reproduce);
+# DEM_RANKS > 1 runs each under mpirun; DEM_CASES="pile box_blade" a subset. Takes CPU hours'
+# fraction: the runs print their LAMMPS CPU time. `make reproduce` only reads the stored files.
+DEM_RANKS ?= 1
+dem: deps
+	@$(PYTHON) experiments/dem/run_dem.py --engine $(ENGINE) --jobs $(JOBS) --ranks $(DEM_RANKS) \
+		$(if $(DEM_CASES),--cases $(DEM_CASES),) $(if $(SLURM_PARTITION),--partition $(SLURM_PARTITION),) \
+		$(if $(SLURM_TIME),--time $(SLURM_TIME),)
 
 bench: build
 	@for b in $(BUILD_DIR)/tests/*_bench; do \

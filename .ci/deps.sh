@@ -15,6 +15,7 @@ packages=(
   libopenvdb-dev libtbb-dev
   libcairo2-dev fonts-dejavu-core libepoxy-dev
   clang-format
+  lammps  # `make dem` and the test suite's tiny particle case; `make reproduce` never runs it
 )
 
 # `deps.sh fuzz` adds clang and its libFuzzer runtime (for `make fuzz` only); `deps.sh lint`

@@ -1,12 +1,14 @@
-"""The engines that execute a sweep's missing runs (runstore specs); the experiments only
-declare runs and aggregate their results, whichever engine ran them.
+"""The engines that execute a sweep's missing runs; the experiments only declare runs and
+aggregate their results, whichever engine ran them. A run is a spec of a runner module:
+runstore (sandbench runs, the default) or dem/run_dem.py (particle references); a runner has
+execute(spec), read_sidecar(spec), stop_children() and a `task MANIFEST INDEX` command line.
 
 - LocalEngine: a pool of `jobs` threads on this machine, each running one sandbench at a time.
 - SlurmEngine: one SLURM job array through `sbatch`, one array task per batch of runs,
   at most `parallel` tasks at once (`--array=0-K%N`); polls `squeue` until the array has
   left the queue, then the driver checks that every run left its sidecar.
 
-Both execute the same runstore.execute() on the same specs, so their run files and sidecars
+Both execute the same runner.execute() on the same specs, so their run files and sidecars
 are the same apart from timings. A stopped sweep (Ctrl-C, SIGTERM) stops its runs (the local
 children, or `scancel` of the array); the finished ones keep their sidecars and the next
 start runs only the rest. If the driver dies without cleaning up (kill -9), the job array it
@@ -63,17 +65,17 @@ class LocalEngine:
     def __init__(self, jobs=2):
         self.jobs = jobs
 
-    def execute(self, specs, label="runs"):
+    def execute(self, specs, label="runs", runner=runstore):
         done = [0]
         lock = threading.Lock()
 
         def one(spec):
-            runstore.execute(spec)
+            runner.execute(spec)
             with lock:
                 done[0] += 1
                 progress(f"  {label}: {done[0]}/{len(specs)} {spec['name']}")
 
-        with _StopOnSignals(runstore.stop_children):
+        with _StopOnSignals(runner.stop_children):
             with concurrent.futures.ThreadPoolExecutor(max_workers=self.jobs) as pool:
                 for f in [pool.submit(one, s) for s in specs]:
                     f.result()
@@ -96,7 +98,7 @@ class SlurmEngine:
                 raise RuntimeError(f"the slurm engine needs `{tool}` on PATH (Debian: slurm-client), and a "
                                    f"cluster that can read this folder")
 
-    def execute(self, specs, label="runs"):
+    def execute(self, specs, label="runs", runner=runstore):
         state = Path(specs[0]["runs"]) / ".slurm"
         state.mkdir(parents=True, exist_ok=True)
         pending = state / "pending.json"
@@ -106,7 +108,7 @@ class SlurmEngine:
                 progress(f"slurm: job array {old} of an earlier start is still queued; waiting for it first")
                 self._wait(old)
             pending.unlink()
-            specs = [s for s in specs if not runstore.read_sidecar(s)]
+            specs = [s for s in specs if not runner.read_sidecar(s)]
             if not specs:
                 return
         batch = max(self.batch, math.ceil(len(specs) / self.MAX_ARRAY_TASKS))
@@ -120,7 +122,7 @@ class SlurmEngine:
                             ("mem", self.mem)):
             if value:
                 cmd.append(f"--{flag}={value}")
-        cmd += self.extra + [f"--wrap=exec /usr/bin/python3 {HERE / 'runstore.py'} task {manifest} "
+        cmd += self.extra + [f"--wrap=exec /usr/bin/python3 {Path(runner.__file__).resolve()} task {manifest} "
                              f"$SLURM_ARRAY_TASK_ID"]
         proc = subprocess.run(cmd, capture_output=True, text=True)
         if proc.returncode != 0:
@@ -133,7 +135,7 @@ class SlurmEngine:
             self._wait(job, len(batches))
         pending.unlink()
         self.job_ids.append(job)
-        failed = [(i, s) for i, b in enumerate(batches) for s in b if not runstore.read_sidecar(s)]
+        failed = [(i, s) for i, b in enumerate(batches) for s in b if not runner.read_sidecar(s)]
         for i, s in failed[:5]:
             log = state / f"{job}_{i}.log"
             tail = log.read_text()[-1500:] if log.exists() else "(no log)"

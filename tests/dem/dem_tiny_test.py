@@ -1,0 +1,67 @@
+#!/usr/bin/python3
+"""The particle reference pipeline end to end on a tiny case (tests/dem/tiny_cases.toml: a few
+hundred grains, seconds of LAMMPS): inputs generated from a scene, `lmp` run, surfaces and the
+tool's force reduced and written to a reference file, which is read back and checked:
+- every surface and force sample finite, the surfaces within the domain's plausible heights;
+- the grains conserved (the same count and grain volume before, with the tool in, and after);
+- the tool met the sand: it was pushed back against its motion while it cut, and the final
+  surface has a cut below the bed along the path;
+- a second start finds the run done and runs nothing.
+Usage: dem_tiny_test.py (LAMMPS's `lmp` on PATH; the test is skipped, exit 77, without it)."""
+import math
+import shutil
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+sys.path.insert(0, str(ROOT / "experiments" / "dem"))
+import reference_file  # noqa: E402
+
+RUN_DEM = [sys.executable, str(ROOT / "experiments" / "dem" / "run_dem.py"),
+           "--cases-file", str(ROOT / "tests" / "dem" / "tiny_cases.toml"), "--seeds", "1"]
+
+
+def check(cond, message):
+    if not cond:
+        sys.exit(f"FAIL: {message}")
+    print(f"ok: {message}")
+
+
+def main():
+    if shutil.which("lmp") is None:
+        print("lmp not found: skipped (Debian: lammps, installed by .ci/deps.sh)")
+        return 77
+    with tempfile.TemporaryDirectory() as tmp:
+        args = RUN_DEM + ["--work", f"{tmp}/work", "--out", f"{tmp}/ref"]
+        proc = subprocess.run(args, capture_output=True, text=True, timeout=600)
+        check(proc.returncode == 0, f"run_dem.py exits 0 ({proc.stderr[-1500:]})")
+        ref = reference_file.Reference(Path(tmp) / "ref" / "tiny.h5")
+        check(ref.lammps_version.startswith("LAMMPS ("), f"provenance names LAMMPS's version: {ref.lammps_version}")
+        check(set(ref.surfaces) == {"initial", "tool_in", "final"}, "three surfaces stored")
+        for stage, s in ref.surfaces.items():
+            check(np.all(np.isfinite(s)) and s.min() >= -1e-9 and s.max() < 0.05, f"{stage} surface finite, 0..5 cm")
+        force = ref.forces["seed1"]
+        check(force.shape[1] == 7 and np.all(np.isfinite(force)), f"force finite, {len(force)} samples")
+        run = ref.runs["seed1"]
+        counts, volumes = run["grains"], run["grain_volume_m3"]
+        check(counts["initial"] > 100 and len(set(counts.values())) == 1, f"grains conserved: {counts}")
+        check(max(volumes.values()) - min(volumes.values()) <= 1e-12 * max(volumes.values()),
+              f"grain volume conserved: {volumes}")
+        moving = (force[:, 1] > 0.013) & (force[:, 1] < 0.027) & (np.abs(np.gradient(force[:, 1])) > 0)
+        check(moving.sum() > 3 and np.mean(force[moving, 4]) < 0,
+              f"the sand pushes back against the motion while the tool cuts "
+              f"(mean fx {np.mean(force[moving, 4]):.3f} N over {moving.sum()} samples)")
+        final = ref.mean("final")
+        axis = final[15, 14:27]  # y = 15 mm, x = 14..26 mm: the path behind the tool
+        check(axis.mean() < 0.008 - 0.001, f"a cut along the path: {1e3 * axis.mean():.2f} mm (bed 8 mm)")
+        again = subprocess.run(args, capture_output=True, text=True, timeout=120)
+        check(again.returncode == 0 and "0 to do" in again.stderr, "a second start runs nothing")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
