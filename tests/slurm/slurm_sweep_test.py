@@ -8,7 +8,9 @@ Starts a single-node cluster on localhost (local_cluster.py), then:
    submit exactly the runs that were missing and reuse the others untouched;
 3. checks that both engines' tables are identical apart from timing columns, and that their
    run files hold the same final surfaces;
-4. prints the job ids it waited for; stops every daemon it started, also on failure.
+4. runs the tiny particle reference case (tests/dem/) through the same engine as a job array
+   (when LAMMPS's `lmp` is installed) and checks that it writes the same surfaces as a local run;
+5. prints the job ids it waited for; stops every daemon it started, also on failure.
 
 Usage: slurm_sweep_test.py SANDBENCH
 """
@@ -56,6 +58,35 @@ def job_ids(stderr):
     return re.findall(r"slurm: submitted job array (\d+)", stderr)
 
 
+RUN_DEM = [sys.executable, str(ROOT / "experiments" / "dem" / "run_dem.py"), "--cases-file",
+           str(ROOT / "tests" / "dem" / "tiny_cases.toml"), "--seeds", "1"]
+
+
+def dem_sweep(cluster, tmp):
+    """The tiny particle case on the local engine and as a job array; failures as strings."""
+    import shutil
+    if shutil.which("lmp") is None:
+        log("dem: lmp not found, the particle case through slurm skipped")
+        return []
+    sys.path.insert(0, str(ROOT / "experiments" / "dem"))
+    import numpy as np
+    import reference_file
+    out = {}
+    for engine in ("local", "slurm"):
+        cmd = RUN_DEM + ["--work", str(tmp / f"dem-{engine}"), "--out", str(tmp / f"dem-{engine}-ref"),
+                         "--engine", engine, "--poll", "0.5"]
+        proc = subprocess.run(cmd, capture_output=True, text=True, env=cluster.env, timeout=600)
+        if proc.returncode != 0:
+            return [f"run_dem.py on the {engine} engine failed ({proc.returncode}):\n{proc.stderr[-3000:]}"]
+        if engine == "slurm" and not job_ids(proc.stderr):
+            return ["run_dem.py on the slurm engine submitted no job array"]
+        log(f"dem: the tiny case on the {engine} engine {'(job array ' + job_ids(proc.stderr)[0] + ')' if engine == 'slurm' else ''}")
+        out[engine] = reference_file.Reference(tmp / f"dem-{engine}-ref" / "tiny.h5")
+    if not all(np.array_equal(out["local"].surfaces[k], out["slurm"].surfaces[k]) for k in out["local"].surfaces):
+        return ["the particle case's surfaces differ between the local and the slurm engine"]
+    return []
+
+
 def main():
     sandbench = str(Path(sys.argv[1]).resolve())
     failures = []
@@ -97,6 +128,7 @@ def main():
                 log(f"job ids waited for: {' '.join(waited)}")
                 if not job_ids(err2) and expected:
                     failures.append("no job array was submitted")
+                failures += dem_sweep(cluster, tmp)
                 for job in waited:  # the cluster's own record of them (kept MinJobAge seconds)
                     info = cluster.run(["scontrol", "show", "job", job], check=False).stdout
                     states = sorted(set(re.findall(r"JobState=(\w+)", info)))
