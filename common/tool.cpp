@@ -16,6 +16,8 @@ constexpr std::pair<ToolShape, std::string_view> kShapeNames[] = {{ToolShape::Di
                                                                   {ToolShape::Pour, "pour"}};
 constexpr std::pair<BottomProfile, std::string_view> kProfileNames[] = {{BottomProfile::Flat, "flat"},
                                                                         {BottomProfile::SphereCap, "sphere_cap"}};
+constexpr std::pair<Displacement, std::string_view> kDisplacementNames[] = {{Displacement::Rim, "rim"},
+                                                                            {Displacement::Bulldoze, "bulldoze"}};
 
 template <typename Enum, std::size_t N>
 std::string name_of(const std::pair<Enum, std::string_view> (&table)[N], Enum e) {
@@ -41,7 +43,9 @@ std::string number(double v) {
 std::string to_string(ToolShape s) { return name_of(kShapeNames, s); }
 std::string to_string(BottomProfile p) { return name_of(kProfileNames, p); }
 std::optional<ToolShape> tool_shape_from(std::string_view name) { return value_of(kShapeNames, name); }
+std::string to_string(Displacement d) { return name_of(kDisplacementNames, d); }
 std::optional<BottomProfile> bottom_profile_from(std::string_view name) { return value_of(kProfileNames, name); }
+std::optional<Displacement> displacement_from(std::string_view name) { return value_of(kDisplacementNames, name); }
 
 std::optional<std::string> ToolSpec::problem() const {
   auto positive = [](const char* key, double v) -> std::optional<std::string> {
@@ -130,7 +134,13 @@ double ToolStamp::rim_weight_outside(const Vec2& p, double d) const {
   double directional = 1.0;
   const Vec2 offset = p - pose.xy;
   const double len = offset.norm();
-  if (len > 0.0 && motion_dir.squaredNorm() > 0.0) {
+  const bool moving = motion_dir.squaredNorm() > 0.0;
+  if (rim.model == Displacement::Bulldoze && moving) {
+    const double ahead = offset.dot(motion_dir);
+    const double across = std::abs(offset.x() * motion_dir.y() - offset.y() * motion_dir.x());
+    return ahead > 0.0 && across <= half_width_m ? taper : 0.0;
+  }
+  if (len > 0.0 && moving) {
     const double c = offset.dot(motion_dir) / len;
     directional = (1.0 + rim.forward_bias * c) / (1.0 + rim.forward_bias);
   }
@@ -160,6 +170,8 @@ ToolStamp make_stamp(const ToolSpec& spec, const ToolPose& pose, const Vec2& mot
   const double c = std::cos(pose.heading_rad), sn = std::sin(pose.heading_rad);
   for (const Vec2& q : spec.footprint_local()) {
     s.footprint.emplace_back(pose.xy.x() + c * q.x() - sn * q.y(), pose.xy.y() + sn * q.x() + c * q.y());
+    const Vec2 offset = s.footprint.back() - pose.xy;
+    s.half_width_m = std::max(s.half_width_m, std::abs(offset.x() * motion_dir.y() - offset.y() * motion_dir.x()));
   }
   return s;
 }

@@ -13,18 +13,28 @@ namespace sb {
 
 enum class ToolShape { Disk, Box, Ellipse, Polygon, Pour };
 enum class BottomProfile { Flat, SphereCap };
+// Where a moving tool puts the sand it cuts: a rim band around the footprint (the paper's
+// related work), or the band ahead of it only, as a blade does (bulldozing).
+enum class Displacement { Rim, Bulldoze };
 
 // Names as in scene files and sessions ("disk", "sphere_cap"), one table each way.
 std::string to_string(ToolShape s);
 std::string to_string(BottomProfile p);
+std::string to_string(Displacement d);
 std::optional<ToolShape> tool_shape_from(std::string_view name);          // disk | box | ellipse | polygon | pour
 std::optional<BottomProfile> bottom_profile_from(std::string_view name);  // flat | sphere_cap
+std::optional<Displacement> displacement_from(std::string_view name);     // rim | bulldoze
 
-// Where the displaced volume goes: a rim band just outside the footprint, weighted
-// towards the direction of motion (Sumner et al. 1999; Onoue & Nishita 2003).
+// Where the displaced volume goes: a band just outside the footprint. `Rim`: all around it,
+// weighted towards the direction of motion (Sumner et al. 1999; Onoue & Nishita 2003).
+// `Bulldoze`: only the part of the band ahead of the footprint and within its width across the
+// motion, so the next stamp cuts it again and the sand is carried with the tool as a growing
+// front pile, which erosion spills to the sides at the angle of repose (the earthmoving
+// models of Holz et al. 2009); a stamp that does not move uses the rim.
 struct RimRule {
   double width_m = 0.01;      // band width outside the footprint boundary
-  double forward_bias = 0.8;  // 0: uniform rim; 1: nothing behind the tool
+  double forward_bias = 0.8;  // rim: 0 uniform; 1 nothing behind the tool
+  Displacement model = Displacement::Rim;
 };
 
 struct ToolSpec {
@@ -67,6 +77,7 @@ struct ToolStamp {
   BottomProfile profile = BottomProfile::Flat;
   double sphere_radius_m = 0.0;
   RimRule rim;
+  double half_width_m = 0.0;    // the footprint's half extent across the motion, from the pose
   double pour_volume_m3 = 0.0;  // > 0 only for pours
   double pour_radius_m = 0.0;
 
@@ -75,8 +86,9 @@ struct ToolStamp {
   double bottom_z(const Vec2& p) const;
   bool contains(const Vec2& p) const { return point_in_polygon(footprint, p); }
   // Weight of the displaced-volume deposit at p: 0 inside the footprint and beyond the
-  // rim band, else (1 + bias cos(phi)) / (1 + bias) * taper, with phi the angle between
-  // the motion and (p - pose), and the taper falling linearly across the band.
+  // band, else the taper falling linearly across the band times, for the rim,
+  // (1 + bias cos(phi)) / (1 + bias) with phi the angle between the motion and (p - pose),
+  // and for bulldozing 1 ahead of the pose within half_width_m across the motion, 0 elsewhere.
   double rim_weight(const Vec2& p) const;
   // The same for a point outside the footprint whose distance to its boundary is known.
   double rim_weight_outside(const Vec2& p, double distance) const;

@@ -43,7 +43,9 @@ PILE_ROWS = [("height_m", "height, mm", 1e3), ("flank_deg", "flank, deg", 1), ("
 
 
 def load_references():
-    return [reference_file.Reference(p) for p in sorted(REFERENCES.glob("*.h5"))]
+    refs = [reference_file.Reference(p) for p in sorted(REFERENCES.glob("*.h5"))]
+    POURS.update(r.case for r in refs if scene_of(r)["tool"].get("shape") == "pour")
+    return refs
 
 
 def scene_of(ref):
@@ -178,6 +180,16 @@ def speed_figure(ctx, cases, names):
     return ctx.figure(fig, "particles_speed_accuracy")
 
 
+POURS = set()  # cases whose tool is a pour, filled by load_references
+
+
+def run_name(ref, label):
+    """The run behind a case's label: a pour's runs are the default model's whatever the label."""
+    if ref.case in POURS:
+        label = label.split()[0]
+    return f"particles/{ref.case}-{label.replace(' ', '-')}"
+
+
 def default_displacement(ctx):
     """The scenes' default `tool.displacement`, as the binary's validator states it."""
     for line in ctx.sandbench_cmd("scene-keys").splitlines():
@@ -223,15 +235,17 @@ def run(ctx):
     refs = load_references()
     default = default_displacement(ctx)
     labels, other = variants(default)
-    jobs = []
+    jobs = {}
     for ref in refs:
         scene_path = sbrun.ROOT / ref.scene
         for label, b, overrides in labels:
-            name = f"particles/{ref.case}-{label.replace(' ', '-')}"
-            jobs.append((scene_path, b, name, overrides))
+            if ref.case in POURS and overrides:  # a pour displaces nothing: its runs are the default's
+                continue
+            name = run_name(ref, label)
+            jobs[name] = (scene_path, b, name, overrides)
             if "tool_in" in ref.surfaces:
-                jobs.append((scene_path, b, name + "-tool_in", overrides + ("erosion.relax_at_end=false",)))
-    summaries = dict(zip([j[2] for j in jobs], ctx.run_many("particles", jobs)))
+                jobs[name + "-tool_in"] = (scene_path, b, name + "-tool_in", overrides + ("erosion.relax_at_end=false",))
+    summaries = dict(zip(jobs, ctx.run_many("particles", list(jobs.values()))))
     names = [label for label, _, _ in labels]
     cases, rows_csv = [], []
     for ref in refs:
@@ -239,17 +253,15 @@ def run(ctx):
         lattice = pm.Lattice(ref.origin, ref.spacing, ref.surfaces["final"].shape[1:])
 
         def surfaces(suffix=""):
-            return {label: raster_of(ctx.runs / f"particles/{ref.case}-{label.replace(' ', '-')}{suffix}.h5", lattice)
-                    for label in names}
+            return {label: raster_of(ctx.runs / f"{run_name(ref, label)}{suffix}.h5", lattice) for label in names}
         final = surfaces()
         table, seeds, backends, base = case_rows(ref, scene, lattice, "final", final)
         case = {"case": ref.case, "scene": ref.scene, "mean": ref.mean("final"), "surfaces": final,
                 "x": ref.xs(), "y": ref.ys(), "backends": backends, "sections": None, "seeds": len(ref.seeds),
                 "dem_cost_s": float(np.median(ref.cpu_seconds())), "dem_seeds": seeds,
                 "critical": scene["material"]["critical_angle_deg"],
-                "cost_s": {label: summaries[f"particles/{ref.case}-{label.replace(' ', '-')}"]["time_s.total"] +
-                           summaries[f"particles/{ref.case}-{label.replace(' ', '-')}"].get("time_s.relax", 0.0)
-                           for label in names},
+                "cost_s": {label: summaries[run_name(ref, label)]["time_s.total"] +
+                           summaries[run_name(ref, label)].get("time_s.relax", 0.0) for label in names},
                 "dilation": dilation(ref, scene, lattice)}
         if base is not None:
             case["sections"] = {"u": seeds[0]["section_u_m"], "seeds": [s["section_z_m"] for s in seeds],
@@ -270,13 +282,14 @@ def run(ctx):
     md = ctx.table("particles", ["case", "surface", "metric", "particles (mean ± sd over seeds)", *names], rows_csv)
     figures = {"sections": section_figure(ctx, cases, names), "difference": difference_figure(ctx, cases),
                "speed": speed_figure(ctx, cases, names)}
-    out = values(cases, md, figures)
+    out = values(cases, md, figures, other)
     out.update({"displacement": default, "compared": other, "tool_force": tool_force_table(ctx, refs, summaries)})
     return out
 
 
-def values(cases, table, figures):
-    """What the report's section says, from this run's numbers."""
+def values(cases, table, figures, other):
+    """What the report's section says, from this run's numbers; `other` the displacement model the
+    back-ends also ran with."""
     out_cases, summary = [], {}
     for c in cases:
         item = {"case": c["case"], "seeds": c["seeds"], "dem_cost_s": c["dem_cost_s"]}
@@ -289,6 +302,7 @@ def values(cases, table, figures):
                          "dem_self_mm": c["dem_self_rmse_m"] * 1e3,
                          "dilation_pct": 100 * c["dilation"][0], "dilation_sd_pct": 100 * c["dilation"][1],
                          "speedup_min": min(speedup), "speedup_max": max(speedup),
+                         "other_rmse_mm": {b: c["backends"][f"{b} {other}"]["section_rmse_m"] * 1e3 for b in BACKENDS},
                          "verdict": ("the shared model: the back-ends agree with each other far better than with the "
                                      "grains, so the distance is the tool model's, not a discretisation's"
                                      if shared else

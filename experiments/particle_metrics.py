@@ -47,6 +47,7 @@ class Stroke:
 
 
 SECTION_BAND = (0.25, 0.70)  # the part of the path whose cross-sections are averaged
+BORDER_M = 0.005  # sections stop this short of the domain's border, where grains cannot reach the wall
 
 
 def section(lattice, surface, stroke, u, band=SECTION_BAND, samples=31):
@@ -75,7 +76,7 @@ def stroke_metrics(lattice, surface, stroke, initial=None):
     """Floor, berms, walls and areas of the averaged cross-section; the pile ahead of the tool at
     the path's end. Heights relative to the bed, in m."""
     spacing = lattice.spacing / 2
-    reach = min(6 * stroke.half_width, 0.5 * _room_across(lattice, stroke))
+    reach = min(6 * stroke.half_width, 0.5 * _room_across(lattice, stroke) - BORDER_M)
     u = np.arange(-reach, reach + spacing / 2, spacing)
     z = section(lattice, surface, stroke, u) - stroke.bed
     axis = np.abs(u) <= 0.25 * stroke.half_width

@@ -69,16 +69,16 @@ def lmp_command(lmp, ranks):
 
 def specs_for(cases_path, cases, seeds, work, material_path, lmp, ranks):
     """One spec per case and seed; its key changes with everything the run depends on."""
-    material_text = Path(material_path).read_text()
+    material = json.dumps(load_toml(material_path), sort_keys=True)  # values, not comments
     all_cases = load_toml(cases_path)
     version = lammps_version(lmp) or "unknown"
-    generator = "".join((HERE / f).read_text() for f in ("lammps_input.py", "surface.py", "run_dem.py"))
+    generator = "".join((HERE / f).read_text() for f in ("lammps_input.py", "surface.py"))
     specs = []
     for name in cases:
         case = all_cases[name]
-        scene_text = (ROOT / case["scene"]).read_text()
+        scene = json.dumps(load_toml(ROOT / case["scene"]), sort_keys=True)
         for seed in seeds:
-            key = hashlib.sha256("\0".join([material_text, scene_text, json.dumps(case, sort_keys=True), version,
+            key = hashlib.sha256("\0".join([material, scene, json.dumps(case, sort_keys=True), version,
                                             generator, str(seed)]).encode()).hexdigest()[:16]
             specs.append({"name": f"{name}/seed{seed}", "runs": str(work), "case_name": name, "case": case,
                           "seed": seed, "material": str(material_path), "lmp": lmp, "ranks": ranks,

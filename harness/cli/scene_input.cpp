@@ -18,6 +18,8 @@ PreparedScene prepare_input(const std::string& scene, const std::vector<std::str
   PreparedScene prepared = prepare_scene(load_scene(scene, all));
   if (!replay.empty()) {
     validate_session(session, prepared.scene, "--replay " + replay);
+    // Sessions record the tools' shapes and rims, not the displacement model: the scene's.
+    for (ToolSpec& t : session.tools) t.rim.model = prepared.scene.tool.rim.model;
     prepared.schedule = session_schedule(session);
     prepared.scene.reference = ReferenceKind::None;
   }

@@ -78,5 +78,32 @@ TEST(RimRule, ZeroInsideAndBeyondBandMoreInFront) {
   EXPECT_GT(front, 5.0 * back);
 }
 
+// Bulldozing puts the sand only ahead of the footprint and within its width across the motion,
+// on any heading; a stamp that does not move spreads it on the rim all around.
+TEST(RimRule, BulldozeOnlyAheadWithinTheWidthOnAnyHeading) {
+  ToolSpec t;
+  t.shape = ToolShape::Box;
+  t.half_size_m = {0.01, 0.015};  // 2 cm along the motion, 3 cm across
+  t.rim.width_m = 0.005;
+  t.rim.model = Displacement::Bulldoze;
+  for (const double heading : {0.0, 0.6, 2.0, -2.5}) {
+    const Vec2 dir(std::cos(heading), std::sin(heading)), across(-dir.y(), dir.x());
+    const Vec2 centre(0.3, -0.2);
+    const ToolStamp s = make_stamp(t, {centre, 0.0, heading}, dir, 0);
+    EXPECT_NEAR(s.half_width_m, 0.015, 1e-12);
+    auto at = [&](double along, double side) { return s.rim_weight(centre + along * dir + side * across); };
+    EXPECT_GT(at(0.012, 0.0), 0.5) << heading;             // just ahead, near full weight
+    EXPECT_GT(at(0.012, 0.0149), 0.5) << heading;          // ahead, at the edge of the width
+    EXPECT_EQ(at(0.012, 0.0151), 0.0) << heading;          // ahead but beside the width
+    EXPECT_EQ(at(0.0, 0.017), 0.0) << heading;             // beside the tool
+    EXPECT_EQ(at(-0.012, 0.0), 0.0) << heading;            // behind it
+    EXPECT_EQ(at(0.016, 0.0), 0.0) << heading;             // beyond the band
+    EXPECT_GT(at(0.011, 0.0), at(0.014, 0.0)) << heading;  // tapering across the band
+  }
+  const ToolStamp still = make_stamp(t, {{0.0, 0.0}, 0.0, 0.0}, {0.0, 0.0}, 0);
+  EXPECT_GT(still.rim_weight({0.0, 0.017}), 0.0);
+  EXPECT_GT(still.rim_weight({-0.012, 0.0}), 0.0);
+}
+
 }  // namespace
 }  // namespace sb
