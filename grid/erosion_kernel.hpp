@@ -76,13 +76,10 @@
 // but is monotone in energy (no pair inverted) only for f <= 2 / (N + 1), 0.22 with 8
 // neighbours, 0.4 with 4. At the default f = 0.5 an 8-neighbour pit overshoots to
 // -1.25 x (it becomes a peak), so a Jacobi sweep would need a fraction 2.25x smaller, and
-// about that many more passes to settle: the dense pass stays Gauss-Seidel. Measured
-// (tests/bench/grid_bench.cpp, BM_JacobiSweep and BM_Settle*: a vectorised two-pass sweep at
-// f = 2/9, every node each pass): 137 M updates/s on the 2048^2 all-active state against this
-// kernel's 191 (interleaved medians of 5); from the 512^2 dunes to rest with fine passes only,
-// 6968 passes and 1.83 G updates in 10.4 s against 2457 passes (f = 0.5) and 0.40 G updates
-// (the active set) in 2.1 s. A Jacobi sweep three times as fast as this one would still need
-// 4.5 s for its updates: a faster sweep of the wrong order settles later.
+// about that many more passes to settle: the dense pass stays Gauss-Seidel. A faster sweep of
+// the wrong order settles later: tests/bench/grid_bench.cpp's BM_JacobiSweep (a vectorised
+// two-pass sweep at f = 2/9, every node each pass) and BM_Settle* (passes, updates and time
+// to rest from the 512^2 dunes) measure both orders.
 //
 // Why not red-black (four colours). With 8 neighbours, four colours (x mod 2, y mod 2) keep
 // same-colour nodes from being neighbours, but two of them can share a neighbour (a diagonal
@@ -95,39 +92,16 @@
 // Cost per visit: 9 height loads (4-neighbour: 5), ~6 floating-point operations per neighbour,
 // plus per transfer one division, and a store per receiving neighbour and one for the centre
 // (visits in vector lanes write every slot: no branch per slot); the gradient rule adds a
-// square root and a division per visit. Measured with AVX-512 (Zen 4 in a virtual machine,
-// tests/bench/grid_bench.cpp, edge rule, 8 neighbours, CPU time, medians of nine runs
-// interleaved with the build before the AVX-512 pass was compiled as one function,
-// dense_pass_avx512; two cores shared with other jobs, so figures move by ~5 % between runs),
-// M updates/s (an update: one node of a span or one active-set visit), now (before): double 102
-// on the pile (101), 158 on the stroke (156), 194 with every node of 2048^2 active (196; 12.5x
-// the plain scalar sweep's 15.5 in the same runs) on one thread, 316-349 of wall time on two
-// (dense_pass's bands at once; medians of 7 in two runs, the lower with another job on the
-// machine: 1.7-1.8x one thread's 191-193, about the same CPU time, 21-22x the scalar sweep);
-// float 51 (49), 70 (67), 99 (95); the
-// gradient rule (AVX-512 lanes), double: 70 on the pile and 101 on the stroke (66, 97). On an
-// EPYC without AVX-512 (AVX2 lanes, the same bench, medians of 3 interleaved runs), the
-// gradient rule four nodes at a time: 26 on the pile and 44 on the stroke, against 14 and 19
-// visiting it one node at a time as before. Measured in the AVX2 lanes (callgrind, which runs
-// no AVX-512; the instructions of erode_ordered per update, unchanged by that build), double / float:
-// grid_bench's pile 180 / 227, its stroke 126 / 169. Four visits in AVX2 lanes take ~320
-// instructions (double); classing a row ~16 per node (AVX2, double; ~29 float); rebuilding the
-// active set after a dense pass ~8 per node of the visited columns. Active-set visits add ~100
-// for the set's bookkeeping. Float costs more than its instructions: the rounding carry chains
-// every transferring visit to the one before (float gains least from the wider lanes). Where
-// the time goes with AVX-512 (perf, sampled, share of the timed passes), before the pass was
-// one function: on the pile ~60 % in the eight-node visits, ~25 % in the pass's bookkeeping
-// (phases, flags, group results), ~9 % rebuilding the set, ~2 % finding the spans (rows of ~31
-// nodes, ~5 groups of ~6 lanes each per row, 88 % of the lanes moving, 8 % of the rows
-// classed); with every node active ~61 % visits, ~19 % classing, ~17 % bookkeeping, ~4 % the
-// set (67 % of the nodes visited in lanes, 74 % of those flagged, 66 % moving). Now one
-// function: ~60 % of its samples on vector instructions on the pile, ~69 % with every node
-// active. What was tried beyond that and did not pay: erosion_lanes_avx512.hpp. The sparse
-// grid runs the same paths on a RowWindow (row_window.hpp) that slides from row to row: each
-// row of a run of adjacent visited rows is read once and its changed heights written back once,
-// O(the columns its windows held); measured in AVX2 lanes (callgrind), 1.07x the dense grid's
-// instructions on trench, 1.10x on the pile, 1.16x on the stroke (1.30x, 1.35x, 1.44x when it
-// copied three rows in and out per visited row).
+// square root and a division per visit. Float costs more than its instructions: the rounding
+// carry chains every transferring visit to the one before, so it gains least from wider
+// lanes. How to measure: tests/bench/grid_bench.cpp (updates per second on the pile, the
+// stroke and 2048^2 all active; BM_AllActiveTwoThreads for dense_pass's two bands; against
+// BM_ReferenceSweep, the plain scalar sweep), callgrind for instructions per update (it runs
+// no AVX-512), perf for where the time goes. What was tried beyond this and did not pay:
+// erosion_lanes_avx512.hpp. The sparse grid runs the same paths on a RowWindow
+// (row_window.hpp) that slides from row to row: each row of a run of adjacent visited rows is
+// read once and its changed heights written back once, O(the columns its windows held);
+// tests/bench/sparse_bench.cpp compares its steps with the dense grid's.
 #include <algorithm>
 #include <array>
 #include <bit>
