@@ -9,7 +9,7 @@ every tick; the table gives the per-tick force change (what the hand feels as cl
 force in steady contact and the passivity observer's final energy from the stats JSON.
 
 As a measurement tool:  exp_haptics.py --measure 5 [--sandbench B] [--set key=value ...]
-prints the medians over 5 runs per back-end (the judged figures of issue 16).
+prints the medians over 5 runs per back-end.
 """
 import json
 import math
