@@ -75,5 +75,7 @@ def run(ctx):
 
     piles = [dict(backend=b, res=res, **both(on, off)) for case, b, res, on, off in pairs if case == "poured pile"]
     deep = [dict(backend=b, **both(on, off)) for case, b, _, on, off in pairs if case == "deep stroke"]
-    worse = [p for p in piles if p["rmse_on"] > 1.2 * p["rmse_off"]]
-    return {"png": png, "table": md, "piles": piles, "deep": deep, "worse": worse}
+    worse = [f"{p['backend']} {p['res']}" for p in piles if p["rmse_on"] > 1.2 * p["rmse_off"]]
+    rmse_ratio = [p["rmse_on"] / p["rmse_off"] for p in piles if p["rmse_off"] > 0]
+    return {"png": png, "table": md, "piles": len(piles), "deep": deep, "worse": worse,
+            "rmse_ratio_min": min(rmse_ratio, default=float("nan")), "rmse_ratio_max": max(rmse_ratio, default=float("nan"))}

@@ -232,7 +232,7 @@ def run(ctx):
             label = {"grid 8-nb": "grid", "sparse 8-nb": "sparse", "grid 4-nb": "grid 4-nb"}.get(r[0], r[0])
             summary[label] = {"accuracy vs analytic references": f"trench worst section {r[4]:.2f} deg"}
     return {"trench_table": trench_md, "worst_table": worst_md, "png": png, "spans": spans, "still": still,
-            "flat": too_flat(s), "meets": meets, "bar": BAR, "trench_azimuths": plan["trench"][0],
+            "flat": too_flat(s)[:4], "flat_count": len(too_flat(s)), "meets": meets, "bar": BAR, "trench_azimuths": plan["trench"][0],
             "ridge_azimuths": plan["ridge"][0], "plane_azimuths": plan["plane"][0], "summary": summary}
 
 
