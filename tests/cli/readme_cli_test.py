@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """The README's usage lines name exactly the options each command accepts: for every
-subcommand of `sandbench --help`, the long options of `sandbench COMMAND --help` (but --help)
-equal those on the README's `sandbench COMMAND ...` lines in its code blocks (continuation
-lines included). A flag added without the README, or one the README keeps after it went, fails.
+subcommand of `sandbench --help`, every option of `sandbench COMMAND --help` (but --help) is
+named on the README's `sandbench COMMAND ...` lines in its code blocks (continuation lines
+included), by its long or its short name, and every flag those lines name is an option. A flag
+added without the README, or one the README keeps after it went, fails.
 
 Usage: readme_cli_test.py SANDBENCH"""
 import re
@@ -11,7 +12,7 @@ import sys
 from pathlib import Path
 
 README = Path(__file__).resolve().parents[2] / "README.md"
-FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
+FLAG = re.compile(r"(?<![\w-])--?[a-zA-Z][a-z0-9-]*")
 
 
 def help_text(sandbench, *args):
@@ -28,16 +29,18 @@ def commands(sandbench):
     return [m.group(1) for m in re.finditer(r"^\s{2}([a-z][a-z-]*)\s", section, re.M)]
 
 
-def cli_flags(sandbench, command):
+def cli_options(sandbench, command):
+    """Each option's names ({'-o', '--out'}), --help left out."""
     text = help_text(sandbench, command)
-    options = text.split("Options:", 1)[1] if "Options:" in text else text
-    flags = set()
-    for line in options.splitlines():
+    section = text.split("Options:", 1)[1] if "Options:" in text else text
+    options = []
+    for line in section.splitlines():
         head = line.strip()
-        if head.startswith("-"):  # an option's own line: its names come before its type and help
-            names = head.split("  ")[0]
-            flags.update(FLAG.findall(names))
-    return flags - {"--help"}
+        if head.startswith("-"):  # an option's own line: its names, comma-separated, before its type
+            names = {n.split("{")[0] for n in head.split()[0].split(",")}
+            if "--help" not in names:
+                options.append(names)
+    return options
 
 
 def readme_flags():
@@ -68,15 +71,17 @@ def main():
     for command in names:
         if command == "help":
             continue
-        have = cli_flags(sandbench, command)
+        options = cli_options(sandbench, command)
         doc = documented.get(command)
         if doc is None:
             failures.append(f"{command}: no `sandbench {command} ...` usage line in README.md")
             continue
-        if have - doc:
-            failures.append(f"{command}: accepts {sorted(have - doc)}, which README.md's usage lines do not name")
-        if doc - have:
-            failures.append(f"{command}: README.md names {sorted(doc - have)}, which the command does not accept")
+        missing = [",".join(sorted(o)) for o in options if not o & doc]
+        if missing:
+            failures.append(f"{command}: accepts {missing}, which README.md's usage lines do not name")
+        unknown = sorted(doc - set().union(*options))
+        if unknown:
+            failures.append(f"{command}: README.md names {unknown}, which the command does not accept")
     for f in failures:
         print("FAIL", f)
     print(f"{len(names) - len(failures)} commands match, {len(failures)} failures")
