@@ -694,9 +694,9 @@ template <int N, bool Gradient, Lanes lanes, class RowStore, class Group, class 
 // itself a choice that changes no height: a row is classed only where the row before showed it
 // pays (its visits left more than an eighth of its span out, or, not classed, more than an
 // eighth of its nodes were visited for nothing); otherwise every node of the row is flagged.
-// On grid_bench's pile and stroke, where nearly every group of eight nodes of a phase holds one
-// that moves, the classing fell from ~10 % of the time to under 1 %; on its all-active dunes,
-// where whole stretches of a row stay put, most rows are still classed.
+// On states where nearly every group of eight nodes of a phase holds one that moves (grid_bench's
+// pile and stroke) most rows go unclassed; where whole stretches of a row stay put (its
+// all-active dunes) most rows are still classed.
 //
 // Cost: O(span nodes) per pass -- the classing vectorised over the row, one visit per
 // unstable node -- plus O(words of the visited rows) to find the spans and update the set.
