@@ -9,7 +9,7 @@ packages=(
   libhdf5-dev libpng-dev libosmesa6-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libtomlplusplus-dev nlohmann-json3-dev
-  python3-numpy python3-matplotlib python3-h5py
+  python3-numpy python3-matplotlib python3-h5py python3-jinja2
   libglfw3-dev libimgui-dev xvfb xauth
   munge slurmctld slurmd slurm-client  # the slurm test's own cluster (it starts and stops the daemons)
   libopenvdb-dev libtbb-dev

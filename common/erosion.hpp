@@ -17,15 +17,11 @@
 //     cap_drop). On a TIN, whose fan gradient averages facets up to an edge length away, s is
 //     the steepest facet slope around the centre (SurfaceGradient::steepest: on a plane the
 //     same), and the TIN caps only where the sand comes to rest (steps without a tool):
-//     measured with |g| always, its cross-sections of trench_azimuth.toml at 0..90 degrees
-//     came out up to 2.2 degrees flatter than critical (1.7 uncapped) and the poured
-//     pile.toml lobed (RMSE 80 um, roundness 0.040, against 55 um and 0.024 uncapped); with
-//     the steepest facet at rest, the pile's RMSE is 50 um (flank 29.76 degrees against
-//     29.43), the relaxed cone.toml's 54-56 um at 35..60 degrees (59-69 uncapped), the trench
-//     sections' mean as before (0.07 degrees from critical), their worst single section 1.36
-//     degrees off against 1.24, and a relaxed plane's steepest facet 30.9 against 30.5 degrees
-//     (results/orientation_worst.md: the cap holds back transfers a noisy facet would have
-//     made). A plane is then at rest at the
+//     capped by |g| always, trench walls come out flatter than critical and the poured pile
+//     lobed; capped by the steepest facet at rest, the pile's flank and the relaxed cones
+//     come closer to critical, at the price of single trench sections a little steeper
+//     (results/orientation_worst.md, results/pile_relax.md: the cap holds back transfers a
+//     noisy facet would have made). A plane is then at rest at the
 //     critical angle in every azimuth and a steeper plane is not; where |g| <= tan_settle
 //     (peaks, pits, kinks, gentle slopes) and toward neighbours sideways or uphill of u, only
 //     the edge rule acts, so no edge ever rests steeper than under the edge rule. The

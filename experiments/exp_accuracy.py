@@ -180,30 +180,16 @@ def run(ctx):
         vals = [(error_of("trench", rs), lab) for rs, lab in pick("trench", rule, lambda lab, b: b == backend)]
         return min(vals) if vals else (float("nan"), "")
 
-    lines = []
+    rules = []
     for rule in RULES["pile"]:
         pg, pt = best_flank(rule, "grid"), best_flank(rule, "tin")
         tg, tt = trench_best(rule, "grid"), trench_best(rule, "tin")
-        tin_pile = f"on the TIN {pt[0]:.2f} ({pt[1]})" if pt[1] else "no TIN pile in this profile"
-        lines.append(
-            f"- {rule} rule: pile flank angle (critical 30 degrees) closest on the grid {pg[0]:.2f} ({pg[1]}), "
-            f"{tin_pile}; roundness of the half-height contour (std/mean of its "
-            f"radius; 0 is a circle) grid 4 neighbours {roundness(rule, lambda lab, b: '4-nb' in lab)}, 8 neighbours "
-            f"{roundness(rule, lambda lab, b: '8-nb' in lab)}, TIN {roundness(rule, lambda lab, b: b == 'tin')}; "
-            f"trench, "
-            f"worst section over azimuths {', '.join(f'{a:g}' for a in AZIMUTHS[ctx.profile_name])}: best grid model "
-            f"{tg[0]:.2f} degrees ({tg[1]}), best TIN model {tt[0]:.2f} ({tt[1]}).")
-    bullets = "\n".join(lines)
-    return f"""## Accuracy against speed: pile, crater, trench
-
-![accuracy]({png})
-
-{md}
-{bullets}
-- With the edge rule the stencil's anisotropy is a property of the grid method, not a bug: a 4-neighbour pile
-  is a diamond, an 8-neighbour one an octagon, and a trench between stencil directions stands too steep.
-  The gradient rule tests the slope along the local downhill direction as well, which removes most of it.
-"""
+        rules.append({"rule": rule, "grid_flank": pg[0], "grid_flank_model": pg[1], "tin_flank": pt[0],
+                      "tin_flank_model": pt[1], "round_4nb": roundness(rule, lambda lab, b: "4-nb" in lab),
+                      "round_8nb": roundness(rule, lambda lab, b: "8-nb" in lab),
+                      "round_tin": roundness(rule, lambda lab, b: b == "tin"), "trench_grid": tg[0],
+                      "trench_grid_model": tg[1], "trench_tin": tt[0], "trench_tin_model": tt[1]})
+    return {"png": png, "table": md, "rules": rules, "azimuths": AZIMUTHS[ctx.profile_name]}
 
 
 if __name__ == "__main__":

@@ -40,20 +40,9 @@ def run(ctx):
     md = ctx.table("alpha_flat", ["alpha_flat deg", "vertices", "triangles", "RMSE m", "max error m", "time s"], rows)
     i04 = alphas.index(0.4) if 0.4 in alphas else len(alphas) // 2
     fewer = s[-1]["vertices"] < 0.95 * s[0]["vertices"]
-    verdict = ("the trade-off is reproduced" if fewer and err[-1] > err[0] else
-               "the trade-off is not reproduced on this scene: simplification examines only L_r, the vertices "
-               "that the tool or erosion changed, and after a stroke few of them are flatter than alpha_flat "
-               "(the stamp already removes the flat inner vertices at tool level)")
-    return f"""## alpha_flat: vertices against height error
-
-![alpha_flat]({png})
-
-{md}
-- *Paper: a lower alpha_flat keeps the model too complex, a higher one flattens it and loses detail; 0.4 works
-  best.* Ours: vertices go from {s[0]['vertices']} (no simplification) to {s[i04]['vertices']} at
-  {alphas[i04]:g} degrees with an RMSE of {err[i04]:.1e} m, and to {s[-1]['vertices']} at {alphas[-1]:g} degrees with
-  {err[-1]:.1e} m: {verdict}; 0.4 degrees costs {err[i04] * 1000:.3f} mm of RMSE on this scene.
-"""
+    return {"png": png, "table": md, "vertices_none": s[0]["vertices"], "vertices_mid": s[i04]["vertices"],
+            "alpha_mid": alphas[i04], "err_mid": err[i04], "vertices_max": s[-1]["vertices"], "alpha_max": alphas[-1],
+            "err_max": err[-1], "tradeoff": fewer and err[-1] > err[0]}
 
 
 if __name__ == "__main__":

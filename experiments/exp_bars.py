@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The pile's and the trench's bars (issue 11) on this machine: each back-end on the scene as shipped,
+"""The pile's and the trench's bars on this machine: each back-end on the scene as shipped,
 several runs each, the back-ends interleaved; per measure the medians of each back-end's runs, their
 ratio TIN / grid against the bar, and the spread of the ratio over the rounds (the machine is shared,
 so step times move between runs; RMSE and memory do not)."""
@@ -29,13 +29,19 @@ def run(ctx):
         jobs += [(sbrun.SCENES / scene, backend, f"bars/{scene.removesuffix('.toml')}-{backend}-{r}", [])
                  for r in range(repeats) for backend in ("tin", "grid")]
     summaries = ctx.run_many("bars", jobs)
-    rows, missed = [], []
+    rows, missed, medians, ns_per_update, updates = [], [], {}, {}, {}
     for k, (scene, measures) in enumerate(BARS.items()):
         runs = summaries[2 * repeats * k:2 * repeats * (k + 1)]
         tin, grid = runs[0::2], runs[1::2]
+        # The cost of one erosion update during the strokes (erosion time over updates, median of the runs).
+        ns_per_update[scene] = {b: statistics.median(1e9 * r["time_s.erosion"] / max(r["erosion_updates"], 1) for r in rs)
+                                for b, rs in (("tin", tin), ("grid", grid))}
+        updates[scene] = (statistics.median(r["erosion_updates"] for r in tin) /
+                          max(statistics.median(r["erosion_updates"] for r in grid), 1))
         for label, key, bar in measures:
             t = statistics.median(r[key] for r in tin)
             g = statistics.median(r[key] for r in grid)
+            medians[scene, key] = {"tin": t, "grid": g}
             ratio = t / g
             per_round = sorted(a[key] / b[key] for a, b in zip(tin, grid))
             if ratio > bar:
@@ -45,15 +51,13 @@ def run(ctx):
                          f"{bar:g}x", "yes" if ratio <= bar else "no"])
     md = ctx.table("bars", ["scene", "measure", "tin median", "grid median", "tin / grid", "per round",
                             "bar", "within"], rows)
-    return f"""## The pile's and the trench's bars on this machine
-
-{md}
-- Each back-end on the scene as shipped, {repeats} runs each, interleaved; the ratio of the medians against the bar
-  (issue 11). Within: {len(rows) - len(missed)} of {len(rows)}; missed: {', '.join(missed) or 'none'}. Step times
-  are the per-step p50 of one run; they move with the machine's other load (the per-round column) and
-  with its vector lanes (the header: the grid's kernel runs its visits in them, the TIN's visits are
-  scalar), so a ratio near its bar can fall either side of it between reproductions.
-"""
+    return {"table": md, "repeats": repeats, "within": len(rows) - len(missed), "measures": len(rows), "missed": missed,
+            "step_ratio": {sc: medians[sc, "step_ms.p50"]["tin"] / medians[sc, "step_ms.p50"]["grid"] for sc in BARS},
+            "ns_per_update": ns_per_update, "update_ratio": updates,
+            "summary": {b: {"step time": f"pile {medians['pile.toml', 'step_ms.p50'][b]:.3f} ms, "
+                                         f"trench {medians['trench.toml', 'step_ms.p50'][b]:.3f} ms",
+                            "settling time": f"pile {medians['pile.toml', 'time_s.relax'][b]:.3f} s"}
+                        for b in ("tin", "grid")}}
 
 
 if __name__ == "__main__":

@@ -71,18 +71,11 @@ def run(ctx):
     md = ctx.table("cliffs", ["cliff", "what", "tin s", "grid s", "time tin / grid", "tin settling updates",
                               "grid settling updates", "tin vertices", "tin settled", "grid settled", "tin drift",
                               "grid drift", "within the bar (time ratio too)"], rows)
-    return f"""## Cliffs: the edges of the envelope
-
-{md}
-- Times are stroke plus settling (`time_s.total` + `time_s.relax`), the median of {repeats} runs per back-end, on
-  `flat_stroke.toml` with the overrides named; the bar (issue 11): the TIN within 10x the grid's time,
-  settled, drift at most 1e-6. Within it: {len(cliffs) - len(missed)} of {len(cliffs)}; missed:
-  {', '.join(missed) or 'none'}.
-- A tool below one grid cell (the boxes, the spikes' thin ends) is where the ratio says least: the grid's
-  5 mm cells miss most of the footprint and move almost no sand. The TIN cuts a footprint into its mesh
-  when it is at least a quarter of `tin.refine_m` wide (4 area / perimeter; 1.7 mm here), so it cuts the
-  2 mm box; the 0.4 mm box lowers the vertices it covers, as the grid lowers its nodes (here none).
-"""
+    ratios = {r[0]: float(r[4].rstrip("x")) for r in rows}
+    worst = max(ratios, key=ratios.get)
+    return {"table": md, "repeats": repeats, "within": len(cliffs) - len(missed), "cliffs": len(cliffs),
+            "missed": missed, "worst": worst, "worst_ratio": ratios[worst],
+            "worst_small": worst.startswith(("box", "spike", "blade"))}
 
 
 if __name__ == "__main__":

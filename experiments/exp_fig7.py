@@ -53,31 +53,9 @@ def run(ctx):
     last = tin[-1]
     share = {name: last[key] / max(last["time_s.total"], 1e-30) for key, name in PARTS}
     dominant = max(share, key=share.get)
-    removal_claim = ("reproduced" if dominant == "removal" else "not reproduced") + \
-        f": at N = {ns[-1]} the largest part is {dominant} ({100 * share[dominant]:.0f}% of the TIN's time; " \
-        f"removal {100 * share['removal']:.0f}%, detection {100 * share['detection']:.0f}%)"
-    growth = "not reproduced" if slopes["removal"] < 1.2 else "reproduced"
-    text = f"""## Figure 7: time of each part against TIN size
-
-Our parts: *tool* is the whole stamp (steps 1a-1f, including the removal of the redundant inner vertices at tool
-level, which the paper counts as vertex removal), *erosion* is step 2, *detection* and *removal* are step 3 (the
-vertices of L_r flatter than alpha_flat).
-
-![fig7]({png})
-
-{md}
-- *Paper: vertex removal is the most time-consuming part.* Ours: {removal_claim}.
-- *Paper: removal grows as O(n^1.5) with TIN size (long walks).* Ours: {growth}; fitted exponent
-  {slopes['removal']:.2f} for removal, {slopes['total']:.2f} for the TIN's total. Point location walks from the
-  last located face, and the lists L_e and L_r hold only what the tool touched, so the cost of a stroke depends
-  on the stroke, not on the size of the model.
-- The grid at the same number of nodes: exponent {grid_slope:.2f} for its total. A grid of more nodes has
-  smaller cells, so the same tool covers more of them: its cost follows the nodes under the tool and in the
-  erosion's active set (about N^1 for a fixed tool), never the whole grid.
-- The sparse grid (OpenVDB, same cells, same heights): exponent {sparse_slope:.2f} for its total,
-  {sparse_ratio[len(sparse_ratio) // 2]:.2f}x the dense grid's time (median over the sizes).
-"""
-    return text
+    return {"png": png, "table": md, "n_max": ns[-1], "dominant": dominant, "shares": {k: 100 * v for k, v in share.items()},
+            "removal_dominant": dominant == "removal", "slopes": slopes, "grid_slope": grid_slope,
+            "sparse_slope": sparse_slope, "sparse_ratio": sparse_ratio[len(sparse_ratio) // 2]}
 
 
 if __name__ == "__main__":

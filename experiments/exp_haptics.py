@@ -9,7 +9,7 @@ every tick; the table gives the per-tick force change (what the hand feels as cl
 force in steady contact and the passivity observer's final energy from the stats JSON.
 
 As a measurement tool:  exp_haptics.py --measure 5 [--sandbench B] [--set key=value ...]
-prints the medians over 5 runs per back-end (the judged figures of issue 16).
+prints the medians over 5 runs per back-end.
 """
 import json
 import math
@@ -130,7 +130,7 @@ def run(ctx):
     import numpy as np
 
     if shutil.which("xvfb-run") is None:
-        return "## Haptic forces on a replayed stroke\n\nSkipped: xvfb-run is not installed (`make deps`).\n"
+        return {"skipped": "xvfb-run is not installed (`make deps`)"}
     workdir = ctx.runs / "haptics"
     # Real-time replays run on this machine whatever the engine; reused only from this binary.
     what = ["haptics replay", RECORDING, SCENE, *BACKENDS]
@@ -170,20 +170,14 @@ def run(ctx):
         m = metrics(*runs[b])
         rows.append([b] + [m[k] for k, _ in COLUMNS])
     md = ctx.table("haptics", ["back-end"] + [name for _, name in COLUMNS], rows)
-    return f"""## Haptic forces on a replayed stroke
-
-The recorded session `experiments/haptics_stroke.csv` replayed through the 1 kHz servo on every back-end
-(`sandbench interactive ... --device replay:FILE --record --stats` under xvfb-run; one run each, real time, so
-the stamps fall where the simulation thread got to them). Steady contact: the tool at its deepest and moving.
-Per-tick change: the norm of F(n) - F(n-1) over every tick. The scene's `[haptics]` defaults apply (README);
-grey: k d, the push of the force model on the patch the servo held, before blending and rate limiting (the
-dips are the tool's own stamps digging out the sand under it, refilled by erosion within tens of ms).
-
-![force versus time]({png_time})
-
-![force versus depth]({png_depth})
-
-{md}"""
+    summary, per_backend = {}, {}
+    for b, row in zip(BACKENDS, rows):
+        m = per_backend[b] = dict(zip([k for k, _ in COLUMNS], row[1:]))
+        summary[b] = {"haptic force quality": f"per-tick step p99 {m['step_p99']:.3g} N, steady {m['steady_force_n']:.2g} N"}
+        if "fps" in runs[b][0]:
+            summary[b]["interactive frame rate"] = f"{runs[b][0]['fps']:.0f} fps (xvfb)"
+    return {"skipped": "", "png_time": png_time, "png_depth": png_depth, "table": md, "metrics": per_backend,
+            "summary": summary}
 
 
 def measure(sandbench, n, overrides, backends):

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Accuracy at any orientation (issue 10): a trench dug at azimuths from 0 to 90 degrees (not
+"""Accuracy at any orientation: a trench dug at azimuths from 0 to 90 degrees (not
 only multiples of 45), a straight ridge poured at several azimuths, a plane tilted above the
 critical angle falling toward several azimuths, and the pile -- with both erosion rules (`edge`,
 the paper's per-neighbour test; `gradient`, the isotropic one) on the TIN, the grid with 4 and
@@ -15,9 +15,8 @@ CRITICAL = 30.0  # material.critical_angle_deg of every scene used here
 RULES = ["edge", "gradient"]
 # label -> (back-end, overrides); the sparse grid runs the dense grid's kernel (same heights),
 # so its rows show the price of its storage, not another accuracy.
-# "tin curved": the TIN with curvature refinement (tin.curvature_tolerance_m = 0.2 mm), the
-# measured way to trade its step time for accuracy (README, scene keys); at 0.3 mm its worst
-# trench section was 0.65 degrees, at 0.2 mm 0.54, for about the same trench step time.
+# "tin curved": the TIN with curvature refinement (tin.curvature_tolerance_m = 0.2 mm), its way
+# to trade step time for accuracy (README, scene keys).
 CURVED = "tin curved"
 CONFIGS = {"tin": ("tin", []), CURVED: ("tin", ["tin.curvature_tolerance_m=0.0002"]),
            "grid 4-nb": ("grid", ["grid.neighbours=4"]), "grid 8-nb": ("grid", ["grid.neighbours=8"]),
@@ -30,13 +29,12 @@ CASES = {
                                        "trench.wall_worst_error_deg")),
     "ridge": ("ridge.toml", ("ridge.flank_angle_mean_deg", "ridge.flank_angle_deg", "ridge.flank_angle_min_deg",
                              "ridge.flank_angle_spread_deg", "ridge.flank_worst_error_deg")),
-    # The plane: local slopes (mean, steepest) and the fitted plane's slope (as "min" column: see rows()).
+    # The plane: local slopes (mean, steepest) and the fitted plane's slope (as "min" column: see case_row).
     "plane": ("plane.toml", ("plane.slope_mean_deg", "plane.slope_max_deg", None, None, None)),
 }
 TRENCH_ALL = [0, 10, 22.5, 30, 45, 60, 67.5, 80, 90]
-# Per profile: case -> (azimuths in degrees, configurations). The tiny profile (tests) runs 18
-# runs of under a second each; the paper profile 178 (144 before the curved TIN: 40 CPU-seconds measured) (the TIN planes
-# are the longest, about 2 CPU-s each; 2 minutes wall with 2 workers on a loaded 2-core machine).
+# Per profile: case -> (azimuths in degrees, configurations); the tiny one is the smoke test's.
+# COST is what the driver announces, an order of magnitude (the TIN planes are the longest runs).
 PLAN = {
     "tiny": {"trench": ([0, 22.5], ["tin", "grid 8-nb"]), "ridge": ([22.5], ["tin", "grid 8-nb"]),
              "plane": ([22.5], ["grid 8-nb"]), "pile": ([0], ["tin", "grid 8-nb"])},
@@ -88,90 +86,82 @@ def job(case, az, cfg, rule):
 _announced = set()
 
 
-def run(ctx):
-    import matplotlib.pyplot as plt
+def settled_text(r):
+    """A run that did not settle is measured all the same, and says so (its angles are those of a
+    surface still moving)."""
+    return "yes" if r["settled"] else f"no (max slope {r['max_slope_deg']:.1f} deg)"
 
-    index = cases(ctx.profile_name)
-    if ctx.profile_name not in _announced:  # the driver calls run() once per round
-        _announced.add(ctx.profile_name)
-        sbrun.progress(f"  orientation: {len(index)} runs in the {ctx.profile_name} profile "
-                       f"({COST[ctx.profile_name]})")
-    s = dict(zip(index, ctx.run_many("orientation", [job(*c) for c in index])))
 
-    # Every case: one row per run. A run that did not settle is measured all the same, and says so
-    # (its angles are those of a surface still moving).
-    def settled(r):
-        return "yes" if r["settled"] else f"no (max slope {r['max_slope_deg']:.1f} deg)"
+def case_row(case, az, cfg, rule, r):
+    """One run's row of orientation_cases."""
+    if case == "pile":
+        flank = r["pile.flank_angle_deg"]
+        return [case, az, cfg, rule, flank, "", "", "", abs(flank - CRITICAL), r["pile.roundness"],
+                r["step_ms.p50"], r["volume_drift_rel"], settled_text(r)]
+    mean_k, max_k, min_k, spread_k, worst_k = CASES[case][1]
+    if case == "plane":  # the fitted plane's slope where the others have their gentlest section
+        worst = max(abs(r["plane.slope_deg"] - CRITICAL), abs(r[max_k] - CRITICAL))
+        return [case, az, cfg, rule, r[mean_k], r[max_k], r["plane.slope_deg"], "", worst, "",
+                r["step_ms.p50"], r["volume_drift_rel"], settled_text(r)]
+    return [case, az, cfg, rule, r[mean_k], r[max_k], r[min_k], r[spread_k], r[worst_k], "",
+            r["step_ms.p50"], r["volume_drift_rel"], settled_text(r)]
 
-    rows = []
-    for (case, az, cfg, rule), r in s.items():
-        if case == "pile":
-            flank = r["pile.flank_angle_deg"]
-            rows.append([case, az, cfg, rule, flank, "", "", "", abs(flank - CRITICAL), r["pile.roundness"],
-                         r["step_ms.p50"], r["volume_drift_rel"], settled(r)])
-            continue
-        mean_k, max_k, min_k, spread_k, worst_k = CASES[case][1]
-        if case == "plane":  # the fitted plane's slope where the others have their gentlest section
-            worst = max(abs(r["plane.slope_deg"] - CRITICAL), abs(r[max_k] - CRITICAL))
-            rows.append([case, az, cfg, rule, r[mean_k], r[max_k], r["plane.slope_deg"], "", worst, "",
-                         r["step_ms.p50"], r["volume_drift_rel"], settled(r)])
-        else:
-            rows.append([case, az, cfg, rule, r[mean_k], r[max_k], r[min_k], r[spread_k], r[worst_k], "",
-                         r["step_ms.p50"], r["volume_drift_rel"], settled(r)])
-    ctx.table("orientation_cases", ["case", "azimuth deg", "model", "rule", "mean deg", "max deg",
-                                    "min deg (plane: fitted)", "spread deg", "worst error deg", "roundness",
-                                    "step ms p50", "drift rel", "settled"], rows)
 
-    # The trench's walls per azimuth: mean / steepest section, one column per model and rule.
-    plan = PLAN[ctx.profile_name]
+def trench_table(ctx, s, plan):
+    """The trench's walls per azimuth: mean / steepest section, one column per model and rule."""
     t_az, t_cfg = plan["trench"]
     columns = [(cfg, rule) for cfg in t_cfg for rule in RULES if not cfg.startswith("sparse")]
-    trench_rows = [[az] + [f"{s[('trench', az, cfg, rule)]['trench.wall_angle_mean_deg']:.2f} / "
-                           f"{s[('trench', az, cfg, rule)]['trench.wall_angle_deg']:.2f}" for cfg, rule in columns]
-                   for az in t_az]
-    trench_md = ctx.table("orientation_trench", ["azimuth deg"] + [f"{cfg} {rule}" for cfg, rule in columns],
-                          trench_rows)
+    rows = [[az] + [f"{s[('trench', az, cfg, rule)]['trench.wall_angle_mean_deg']:.2f} / "
+                    f"{s[('trench', az, cfg, rule)]['trench.wall_angle_deg']:.2f}" for cfg, rule in columns]
+            for az in t_az]
+    return ctx.table("orientation_trench", ["azimuth deg"] + [f"{cfg} {rule}" for cfg, rule in columns], rows)
 
-    # The worst case over orientations per model and rule.
-    def worst(case, cfg, rule, key, of=lambda v: abs(v - CRITICAL)):
+
+# The bar every model and rule is judged against: trench mean within 0.3 degree and every section
+# within 0.6 at every azimuth, pile flank within 0.5; roundness at most 0.02 (TIN and 8 neighbours).
+BAR = {"trench_mean": 0.3, "trench_section": 0.6, "pile_flank": 0.5, "roundness": 0.02}
+
+
+def worst_row(s, plan, cfg, rule):
+    """The worst case over orientations of one model and rule, and whether it meets BAR."""
+    def worst(case, key, of=lambda v: abs(v - CRITICAL)):
         """(largest of(value), its azimuth) over the case's azimuths; ("", "") if not run."""
         vals = [(of(s[(case, az, cfg, rule)][key]), az) for az in plan[case][0] if (case, az, cfg, rule) in s]
         return max(vals) if vals else ("", "")
 
-    worst_rows = []
-    for cfg in CONFIGS:
-        for rule in RULES:
-            if not any(c == cfg for _, _, c, _ in index):
-                continue
-            tm, tma = worst("trench", cfg, rule, "trench.wall_angle_mean_deg")
-            tw, twa = worst("trench", cfg, rule, "trench.wall_worst_error_deg", of=lambda v: v)
-            rm, _ = worst("ridge", cfg, rule, "ridge.flank_angle_mean_deg")
-            rw, _ = worst("ridge", cfg, rule, "ridge.flank_worst_error_deg", of=lambda v: v)
-            pf, pfa = worst("plane", cfg, rule, "plane.slope_deg")
-            pm, _ = worst("plane", cfg, rule, "plane.slope_max_deg", of=lambda v: v)
-            pile = s.get(("pile", 0, cfg, rule))
-            flank = pile["pile.flank_angle_deg"] if pile else ""
-            roundness = pile["pile.roundness"] if pile else ""
-            # Issue 10's bar: trench mean within 0.3 degree and every section within 0.6 at every
-            # azimuth, pile flank within 0.5; roundness at most 0.02 (TIN and 8 neighbours).
-            runs = [r for (c, _, m, ru), r in s.items() if m == cfg and ru == rule]
-            unsettled = sum(not r["settled"] for r in runs)
-            checks = [tm != "" and tm <= 0.3, tw != "" and tw <= 0.6, unsettled == 0]
-            if pile:
-                checks.append(abs(flank - CRITICAL) <= 0.5)
-                if cfg != "grid 4-nb":
-                    checks.append(roundness <= 0.02)
-            trench_ms = [s[("trench", az, cfg, rule)]["step_ms.p50"] for az in t_az if ("trench", az, cfg, rule) in s]
-            worst_rows.append([cfg, rule, tm, tma, tw, twa, rm, rw, pf, pfa, pm, flank, roundness,
-                               sorted(trench_ms)[len(trench_ms) // 2] if trench_ms else "",
-                               f"{len(runs) - unsettled}/{len(runs)}", "yes" if all(checks) else "no"])
-    worst_md = ctx.table("orientation_worst", ["model", "rule", "trench mean error deg", "at azimuth",
-                                               "trench worst section deg", "at azimuth", "ridge mean error deg",
-                                               "ridge worst section deg", "plane fit error deg", "at azimuth",
-                                               "plane steepest local deg", "pile flank deg", "pile roundness",
-                                               "trench step ms p50", "runs settled", "meets issue 10"], worst_rows)
+    tm, tma = worst("trench", "trench.wall_angle_mean_deg")
+    tw, twa = worst("trench", "trench.wall_worst_error_deg", of=lambda v: v)
+    rm, _ = worst("ridge", "ridge.flank_angle_mean_deg")
+    rw, _ = worst("ridge", "ridge.flank_worst_error_deg", of=lambda v: v)
+    pf, pfa = worst("plane", "plane.slope_deg")
+    pm, _ = worst("plane", "plane.slope_max_deg", of=lambda v: v)
+    pile = s.get(("pile", 0, cfg, rule))
+    flank = pile["pile.flank_angle_deg"] if pile else ""
+    roundness = pile["pile.roundness"] if pile else ""
+    runs = [r for (c, _, m, ru), r in s.items() if m == cfg and ru == rule]
+    unsettled = sum(not r["settled"] for r in runs)
+    checks = [tm != "" and tm <= BAR["trench_mean"], tw != "" and tw <= BAR["trench_section"], unsettled == 0]
+    if pile:
+        checks.append(abs(flank - CRITICAL) <= BAR["pile_flank"])
+        if cfg != "grid 4-nb":
+            checks.append(roundness <= BAR["roundness"])
+    t_az = plan["trench"][0]
+    trench_ms = [s[("trench", az, cfg, rule)]["step_ms.p50"] for az in t_az if ("trench", az, cfg, rule) in s]
+    return [cfg, rule, tm, tma, tw, twa, rm, rw, pf, pfa, pm, flank, roundness,
+            sorted(trench_ms)[len(trench_ms) // 2] if trench_ms else "",
+            f"{len(runs) - unsettled}/{len(runs)}", "yes" if all(checks) else "no"]
 
-    # Angles against azimuth: one line per model (colour) and rule (dashed: edge; solid: gradient).
+
+WORST_HEADERS = ["model", "rule", "trench mean error deg", "at azimuth", "trench worst section deg", "at azimuth",
+                 "ridge mean error deg", "ridge worst section deg", "plane fit error deg", "at azimuth",
+                 "plane steepest local deg", "pile flank deg", "pile roundness", "trench step ms p50",
+                 "runs settled", "meets the bar"]
+
+
+def angle_chart(ctx, s, plan):
+    """Angles against azimuth: one line per model (colour) and rule (dashed: edge; solid: gradient)."""
+    import matplotlib.pyplot as plt
+
     colours = {"tin": "C3", CURVED: "C4", "grid 4-nb": "C1", "grid 8-nb": "C0"}
     panels = [("trench", "trench.wall_angle_mean_deg", "trench walls, mean of the sections"),
               ("trench", "trench.wall_angle_deg", "trench walls, steepest section"),
@@ -196,49 +186,54 @@ def run(ctx):
         ax.set_xlim(-3, 93)
     axes[0].set_ylabel("angle [deg] (critical 30)")
     axes[0].legend(fontsize=7)
-    png = ctx.figure(fig, "orientation")
+    return ctx.figure(fig, "orientation")
+
+
+def too_flat(s):
+    """Where a rule leaves a surface flatter than critical by more than half a degree (pile, plane)."""
+    out = set()
+    for (case, az, cfg, rule), r in s.items():
+        key = {"pile": "pile.flank_angle_deg", "plane": "plane.slope_deg"}.get(case)
+        if key and r[key] < CRITICAL - 0.5:
+            out.add(f"{cfg} {rule} ({case} {r[key]:.2f}{'' if case == 'pile' else f' at {az:g} deg'})")
+    return sorted(out)
+
+
+def run(ctx):
+    index = cases(ctx.profile_name)
+    if ctx.profile_name not in _announced:  # the driver calls run() once per round
+        _announced.add(ctx.profile_name)
+        sbrun.progress(f"  orientation: {len(index)} runs in the {ctx.profile_name} profile "
+                       f"({COST[ctx.profile_name]})")
+    s = dict(zip(index, ctx.run_many("orientation", [job(*c) for c in index])))
+    plan = PLAN[ctx.profile_name]
+    ctx.table("orientation_cases", ["case", "azimuth deg", "model", "rule", "mean deg", "max deg",
+                                    "min deg (plane: fitted)", "spread deg", "worst error deg", "roundness",
+                                    "step ms p50", "drift rel", "settled"],
+              [case_row(*k, r) for k, r in s.items()])
+    trench_md = trench_table(ctx, s, plan)
+    worst_rows = [worst_row(s, plan, cfg, rule) for cfg in CONFIGS for rule in RULES
+                  if any(c == cfg for _, _, c, _ in index)]
+    worst_md = ctx.table("orientation_worst", WORST_HEADERS, worst_rows)
+    png = angle_chart(ctx, s, plan)
 
     def span(rule, col):
         vals = [r[col] for r in worst_rows if r[1] == rule and r[col] != ""]
         return max(vals) if vals else float("nan")
 
-    meets = {rule: [r[0] for r in worst_rows if r[1] == rule and r[-1] == "yes"] for rule in RULES}
-    # Where a rule leaves a surface flatter than critical by more than half a degree (pile, plane).
-    flat = sorted({f"{cfg} {rule} ({case} {s[k][key]:.2f}{'' if case == 'pile' else f' at {az:g} deg'})" for k in s
-                   for case, az, cfg, rule in [k] for c, key in (("pile", "pile.flank_angle_deg"),
-                                                                  ("plane", "plane.slope_deg"))
-                   if case == c and s[k][key] < CRITICAL - 0.5})
+    spans = {rule: {"trench_mean": span(rule, 2), "trench_section": span(rule, 4), "plane": span(rule, 8)}
+             for rule in RULES}
     still = [f"{cfg} at {az:g} deg" for case, az, cfg, rule in s if case == "plane" and rule == "edge"
              and s[(case, az, cfg, rule)]["plane.slope_deg"] > CRITICAL + 4.9]
-    still_text = ("\n  A 35-degree plane that does not move at all: " + ", ".join(still) + " (along every stencil "
-                  "direction it is less steep than critical: atan(tan 35 cos 45) = 26.3 degrees)." if still else "")
-    return f"""## Accuracy at any orientation: trench, ridge, plane and pile, both erosion rules
-
-Each case is turned through the azimuths below and run with both rules (`erosion.rule = "edge"`, the
-paper's per-neighbour test, and `"gradient"`) on every back-end; angles are against the critical angle
-of 30 degrees. Mean and steepest wall angle per azimuth (`orientation_trench.csv`; the sparse grid has the
-dense grid's heights and is left out):
-
-{trench_md}
-![angles against azimuth]({png})
-
-The worst case over orientations (every case and azimuth in `orientation_cases.csv`): the largest
-distance from the critical angle of the sections' mean (trench, ridge), of one section, and of the fitted
-plane, with the azimuth where it occurs; the steepest local slope on the plane; the pile (no azimuth).
-
-{worst_md}
-- Edge rule: the trench's mean wall angle is off by up to {span('edge', 2):.2f} degrees and one section by up to
-  {span('edge', 4):.2f}; the tilted plane rests up to {span('edge', 8):.2f} degrees too steep. The rule tests slopes
-  along neighbour directions only, so a surface whose downhill direction falls between them stands steeper.{still_text}
-- Gradient rule: {span('gradient', 2):.2f} and {span('gradient', 4):.2f} degrees on the trench,
-  {span('gradient', 8):.2f} on the plane.
-- Flatter than critical by more than half a degree: {"; ".join(flat) or "none"}.
-- Issue 10's bar (trench mean within 0.3 degree and every section within 0.6 at every azimuth, pile flank
-  within 0.5, roundness at most 0.02 on the TIN and the 8-neighbour grid): met by
-  {', '.join(f'{c} with the {rule} rule' for rule in RULES for c in meets[rule]) or 'no model'}.
-  Azimuths: trench {', '.join(f'{a:g}' for a in t_az)}; ridge {', '.join(f'{a:g}' for a in plan['ridge'][0])};
-  plane {', '.join(f'{a:g}' for a in plan['plane'][0])} degrees.
-"""
+    meets = [f"{r[0]} with the {r[1]} rule" for rule in RULES for r in worst_rows if r[1] == rule and r[-1] == "yes"]
+    summary = {}
+    for r in worst_rows:
+        if r[1] == "gradient" and r[4] != "":
+            label = {"grid 8-nb": "grid", "sparse 8-nb": "sparse", "grid 4-nb": "grid 4-nb"}.get(r[0], r[0])
+            summary[label] = {"accuracy vs analytic references": f"trench worst section {r[4]:.2f} deg"}
+    return {"trench_table": trench_md, "worst_table": worst_md, "png": png, "spans": spans, "still": still,
+            "flat": too_flat(s)[:4], "flat_count": len(too_flat(s)), "meets": meets, "bar": BAR, "trench_azimuths": plan["trench"][0],
+            "ridge_azimuths": plan["ridge"][0], "plane_azimuths": plan["plane"][0], "summary": summary}
 
 
 if __name__ == "__main__":

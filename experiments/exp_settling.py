@@ -62,34 +62,14 @@ def run(ctx):
     two = by_variant["grid, 2 threads"][-1]
     two_s = two["time_s.total"] + two["time_s.relax"]
     meets = largest["cells"] >= 5e6 and largest_s <= TARGET_S and exponent <= TARGET_EXPONENT
-    return f"""## Settling against resolution
-
-`flat_stroke.toml` with `grid.cell_m` from {cells[0] * 1000:g} mm down to {cells[-1] * 1000:g} mm; stroke and
-settling are timed apart (the summary's `time_s.total` and `time_s.relax`), and the erosion updates of each count
-the work. Settling runs in calls of up to 64 passes; on grids the runner's settling calls take the multi-resolution
-cascade (grid/multires_settle.hpp) when it pays.
-
-![settling]({png})
-
-{md}
-- The dense grid with the default rule: {largest_s:.2f} s for stroke and settling at {largest['cells'] / 1e6:.1f} M
-  nodes, exponent {exponent:.2f} of that time against the node count (settling updates: {fits['grid'][1]:.2f}).
-  The testbed's target (at most {TARGET_S:g} s at 5.1 M nodes, exponent at most {TARGET_EXPONENT:g} from 0.32 M nodes) is
-  {'met' if meets else 'not met' if largest['cells'] >= 5e6 else 'not measured at 5.1 M nodes by this profile'}.
-- The paper's edge rule: exponent {fits['grid (edge rule)'][0]:.2f}; the sparse grid: {fits['sparse'][0]:.2f}
-  (it runs the dense grid's kernel on its own storage).
-- On two threads (`grid.threads = 2`): {two_s:.2f} s at {two['cells'] / 1e6:.1f} M nodes against one thread's
-  {largest_s:.2f} s, with {'the same' if two['relax_updates'] == largest['relax_updates'] else 'DIFFERENT'} settling
-  updates (the heights do not depend on the threads). Little to gain here: only passes over at least 2^16 nodes in
-  32 rows split into bands, and at 5.1 M nodes the cascade's coarse levels (one thread) take about as much time as
-  the dense passes (perf, sampled: 10.3 % and 10.4 % of the run's samples, the rest the stroke, the active-set
-  sweeps, the run file), not all of which are that large (alone on the machine, 3 interleaved runs at 5.1 M nodes:
-  settling 0.41 s on one thread, 0.38-0.40 s on two); these runs also go two at a time, so a second thread
-  competes with the other run.
-  Two threads pay where most of a large grid is active at once (`grid_bench`'s `BM_AllActiveTwoThreads`: 1.8x).
-  The comparison with the TIN runs one thread.
-- Exponents come from single runs on a shared machine, two at a time; the update counts are exact.
-"""
+    return {"png": png, "table": md, "cell_first_mm": cells[0] * 1000, "cell_last_mm": cells[-1] * 1000,
+            "largest_s": largest_s, "largest_mnodes": largest["cells"] / 1e6, "exponent": exponent,
+            "update_exponent": fits["grid"][1], "target_s": TARGET_S, "target_exponent": TARGET_EXPONENT,
+            "target": "met" if meets else "not met" if largest["cells"] >= 5e6 else "not measured at 5.1 M nodes",
+            "edge_exponent": fits["grid (edge rule)"][0], "sparse_exponent": fits["sparse"][0], "two_s": two_s,
+            "two_mnodes": two["cells"] / 1e6, "same_updates": two["relax_updates"] == largest["relax_updates"],
+            "summary": {"grid": {"settling time": f"{largest_s:.2f} s at {largest['cells'] / 1e6:.1f} M nodes "
+                                                  f"(exponent {exponent:.2f})"}}}
 
 
 if __name__ == "__main__":

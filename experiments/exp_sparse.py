@@ -35,28 +35,16 @@ def run(ctx):
     worst_mem = max(local, key=lambda r: r[4])
     step = sorted(r[5] for r in rows)
     full = [r for r in rows if r[0] in ("dunes", "heightmap")]
+    settle = [r[6] for r in rows if r[6] == r[6]] or [float("nan")]
     kept = worst_mem[4] <= 0.2
-    full_text = (f", and a terrain with detail everywhere saves only {1 - max(r[4] for r in full):.0%}" if full else "")
-    return f"""## The sparse grid (OpenVDB): the paper's memory promise without the TIN's costs?
-
-{md}
-- Heights: the sparse grid runs the dense grid's stamp and erosion kernel on its own storage and ends with
-  {'the same heights on every scene' if all(same.values()) else 'different heights on ' + ', '.join(k for k, v in same.items() if not v)}
-  (final rasters compared bit for bit), so it has the dense grid's accuracy at every cell size.
-- Memory: where a stroke disturbs a small part of the domain the sparse grid needs
-  {', '.join(f"{r[4]:.2f}x" for r in local)} of the dense grid's bytes ({', '.join(r[0] for r in local)});
-  {'at most a fifth' if kept else f'not a fifth on {worst_mem[0]}, where the stroke disturbs about a quarter of the nodes'}.
-  Where every node differs it costs {', '.join(f"{r[4]:.2f}x" for r in full)} ({', '.join(r[0] for r in full)}):
-  a leaf holds 64 nodes at 8.6 bytes each against the dense grid's 10.1.
-  It needs fewer bytes than the TIN on {', '.join(beats_tin) or 'no scene'}.
-- Speed: per-step time p50 {step[0]:.2f}x..{step[-1]:.2f}x the dense grid's (each height read goes through a block
-  table), with no retriangulation, no simplification pass and no volume drift beyond rounding
-  ({max(abs(r[7]) for r in rows):.1e}).
-- Verdict: {'yes' if kept and step[-1] <= 2.0 else 'partly'} -- the sparse grid keeps the memory promise for local
-  edits of a large flat bed at grid speed and grid accuracy, {'and' if kept else 'but'} its memory follows the
-  disturbed area in whole 8 x 8 blocks: the {worst_mem[0]} stroke costs {worst_mem[4]:.2f}x the dense grid{full_text}.
-  Times are single runs on a shared machine; settling times under a millisecond are noise.
-"""
+    drift = max(abs(r[7]) for r in rows)
+    return {"table": md, "all_same": all(same.values()), "differ": [k for k, v in same.items() if not v],
+            "local": [{"scene": r[0], "memory": r[4]} for r in local],
+            "full": [{"scene": r[0], "memory": r[4]} for r in full],
+            "beats_tin": beats_tin, "kept": kept, "worst_scene": worst_mem[0], "worst_memory": worst_mem[4],
+            "step_min": step[0], "step_max": step[-1], "drift": drift, "verdict": "yes" if kept and step[-1] <= 2.0 else "partly",
+            "summary": {"sparse": {"step time": f"{step[0]:.2f}-{step[-1]:.2f}x the grid's",
+                                   "settling time": f"{min(settle):.2f}-{max(settle):.2f}x the grid's"}}}
 
 
 if __name__ == "__main__":

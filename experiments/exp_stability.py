@@ -110,15 +110,13 @@ def run(ctx):
     reasons = [[name, b, outcomes[(name, b)]["outcome"], outcomes[(name, b)]["reason"]]
                for name in cases for b in backends if outcomes[(name, b)]["outcome"] != "ok"]
     md_reasons = ctx.table("stability_reasons", ["case", "backend", "outcome", "reason"], reasons)
-    crashed = [r for r in reasons if r[2] == "crashed"]
-    return f"""## Stability matrix
-
-{md}
-Every cell that is not ok, with its reason:
-
-{md_reasons}
-- Crashed cells: {len(crashed)} ({', '.join(f'{r[0]} on {r[1]}' for r in crashed) or 'none'}).
-"""
+    crashed = [f"{r[0]} on {r[1]}" for r in reasons if r[2] == "crashed"]
+    summary = {}
+    for b in ("tin", "grid", "sparse"):
+        counts = {o: sum(outcomes[(n, b)]["outcome"] == o for n in cases) for o in ("ok", "degraded", "refused", "crashed")}
+        text = ", ".join(f"{n} {o}" for o, n in counts.items() if n)
+        summary[b] = {"stability": f"{text} of {len(cases)} cases"}
+    return {"table": md, "reasons_table": md_reasons, "crashed": crashed, "cases": len(cases), "summary": summary}
 
 
 if __name__ == "__main__":

@@ -225,12 +225,15 @@ def env_ok():
 
 
 def main(run):
-    """Command line of a single experiment script: runs it and prints its report section."""
+    """Command line of a single experiment script (experiments/exp_KEY.py): runs it and prints its
+    report section."""
     import argparse
+    import report
     ap = argparse.ArgumentParser()
     ap.add_argument("--sandbench", default=str(ROOT / "build/release/harness/sandbench"))
     ap.add_argument("--results", default=str(ROOT / "results"))
     ap.add_argument("--profile", default="paper", choices=PROFILES)
     a = ap.parse_args()
     env_ok()
-    print(run(Context(a.sandbench, a.results, a.profile)))
+    key = Path(sys.argv[0]).stem.removeprefix("exp_")
+    print(report.render(key, run(Context(a.sandbench, a.results, a.profile))))

@@ -16,6 +16,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "tests" / "sweeps"))
 from sweep_checks import sidecars  # noqa: E402  {finished run: (sidecar mtime, key)}
+from report import prose_words  # noqa: E402
+WORD_BUDGET = 3300  # REPORT.md's prose (tests/report/report_test.py)
 FIGURES = ["fig5_tin_shaded.png", "fig5_tin_wireframe.png", "fig6_grid_shaded.png", "fig5_6_side_by_side.png",
            "fig5_6_difference.png", "fig7_time_vs_size.png", "fig8_time_vs_trace.png", "fig9_elements_vs_trace.png",
            "memory.png", "drift.png", "alpha_flat.png", "accuracy_speed.png", "orientation.png", "settling.png",
@@ -57,10 +59,13 @@ def main():
         report = (out / "REPORT.md").read_text()
         if not (out / "stability.md").exists():
             sys.exit("missing stability.md")
-        for heading in ["Figure 7", "Figure 8", "Figure 9", "Memory", "drift", "alpha_flat", "Figures 5 and 6",
-                        "Accuracy", "any orientation", "Stability"]:
+        for heading in ["## Abstract", "| back-end |", "Figure 7", "Figures 8 and 9", "Memory", "drift", "alpha_flat",
+                        "Figures 5 and 6", "Accuracy", "any orientation", "Stability"]:
             if heading not in report:
                 sys.exit(f"REPORT.md has no section for {heading}")
+        words = prose_words(report)
+        if words > WORD_BUDGET:
+            sys.exit(f"REPORT.md has {words} words of prose, over the budget of {WORD_BUDGET}")
         # A third start runs nothing and rewrites every output with the same bytes (SVGs included).
         outputs = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
         third = subprocess.run(cmd, check=True, capture_output=True, text=True)

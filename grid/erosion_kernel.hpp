@@ -76,13 +76,10 @@
 // but is monotone in energy (no pair inverted) only for f <= 2 / (N + 1), 0.22 with 8
 // neighbours, 0.4 with 4. At the default f = 0.5 an 8-neighbour pit overshoots to
 // -1.25 x (it becomes a peak), so a Jacobi sweep would need a fraction 2.25x smaller, and
-// about that many more passes to settle: the dense pass stays Gauss-Seidel. Measured
-// (tests/bench/grid_bench.cpp, BM_JacobiSweep and BM_Settle*: a vectorised two-pass sweep at
-// f = 2/9, every node each pass): 137 M updates/s on the 2048^2 all-active state against this
-// kernel's 191 (interleaved medians of 5); from the 512^2 dunes to rest with fine passes only,
-// 6968 passes and 1.83 G updates in 10.4 s against 2457 passes (f = 0.5) and 0.40 G updates
-// (the active set) in 2.1 s. A Jacobi sweep three times as fast as this one would still need
-// 4.5 s for its updates: a faster sweep of the wrong order settles later.
+// about that many more passes to settle: the dense pass stays Gauss-Seidel. A faster sweep of
+// the wrong order settles later: tests/bench/grid_bench.cpp's BM_JacobiSweep (a vectorised
+// two-pass sweep at f = 2/9, every node each pass) and BM_Settle* (passes, updates and time
+// to rest from the 512^2 dunes) measure both orders.
 //
 // Why not red-black (four colours). With 8 neighbours, four colours (x mod 2, y mod 2) keep
 // same-colour nodes from being neighbours, but two of them can share a neighbour (a diagonal
@@ -95,39 +92,16 @@
 // Cost per visit: 9 height loads (4-neighbour: 5), ~6 floating-point operations per neighbour,
 // plus per transfer one division, and a store per receiving neighbour and one for the centre
 // (visits in vector lanes write every slot: no branch per slot); the gradient rule adds a
-// square root and a division per visit. Measured with AVX-512 (Zen 4 in a virtual machine,
-// tests/bench/grid_bench.cpp, edge rule, 8 neighbours, CPU time, medians of nine runs
-// interleaved with the build before the AVX-512 pass was compiled as one function,
-// dense_pass_avx512; two cores shared with other jobs, so figures move by ~5 % between runs),
-// M updates/s (an update: one node of a span or one active-set visit), now (before): double 102
-// on the pile (101), 158 on the stroke (156), 194 with every node of 2048^2 active (196; 12.5x
-// the plain scalar sweep's 15.5 in the same runs) on one thread, 316-349 of wall time on two
-// (dense_pass's bands at once; medians of 7 in two runs, the lower with another job on the
-// machine: 1.7-1.8x one thread's 191-193, about the same CPU time, 21-22x the scalar sweep);
-// float 51 (49), 70 (67), 99 (95); the
-// gradient rule (AVX-512 lanes), double: 70 on the pile and 101 on the stroke (66, 97). On an
-// EPYC without AVX-512 (AVX2 lanes, the same bench, medians of 3 interleaved runs), the
-// gradient rule four nodes at a time: 26 on the pile and 44 on the stroke, against 14 and 19
-// visiting it one node at a time as before. Measured in the AVX2 lanes (callgrind, which runs
-// no AVX-512; the instructions of erode_ordered per update, unchanged by that build), double / float:
-// grid_bench's pile 180 / 227, its stroke 126 / 169. Four visits in AVX2 lanes take ~320
-// instructions (double); classing a row ~16 per node (AVX2, double; ~29 float); rebuilding the
-// active set after a dense pass ~8 per node of the visited columns. Active-set visits add ~100
-// for the set's bookkeeping. Float costs more than its instructions: the rounding carry chains
-// every transferring visit to the one before (float gains least from the wider lanes). Where
-// the time goes with AVX-512 (perf, sampled, share of the timed passes), before the pass was
-// one function: on the pile ~60 % in the eight-node visits, ~25 % in the pass's bookkeeping
-// (phases, flags, group results), ~9 % rebuilding the set, ~2 % finding the spans (rows of ~31
-// nodes, ~5 groups of ~6 lanes each per row, 88 % of the lanes moving, 8 % of the rows
-// classed); with every node active ~61 % visits, ~19 % classing, ~17 % bookkeeping, ~4 % the
-// set (67 % of the nodes visited in lanes, 74 % of those flagged, 66 % moving). Now one
-// function: ~60 % of its samples on vector instructions on the pile, ~69 % with every node
-// active. What was tried beyond that and did not pay: erosion_lanes_avx512.hpp. The sparse
-// grid runs the same paths on a RowWindow (row_window.hpp) that slides from row to row: each
-// row of a run of adjacent visited rows is read once and its changed heights written back once,
-// O(the columns its windows held); measured in AVX2 lanes (callgrind), 1.07x the dense grid's
-// instructions on trench, 1.10x on the pile, 1.16x on the stroke (1.30x, 1.35x, 1.44x when it
-// copied three rows in and out per visited row).
+// square root and a division per visit. Float costs more than its instructions: the rounding
+// carry chains every transferring visit to the one before, so it gains least from wider
+// lanes. How to measure: tests/bench/grid_bench.cpp (updates per second on the pile, the
+// stroke and 2048^2 all active; BM_AllActiveTwoThreads for dense_pass's two bands; against
+// BM_ReferenceSweep, the plain scalar sweep), callgrind for instructions per update (it runs
+// no AVX-512), perf for where the time goes. What was tried beyond this and did not pay:
+// erosion_lanes_avx512.hpp. The sparse grid runs the same paths on a RowWindow
+// (row_window.hpp) that slides from row to row: each row of a run of adjacent visited rows is
+// read once and its changed heights written back once, O(the columns its windows held);
+// tests/bench/sparse_bench.cpp compares its steps with the dense grid's.
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -566,6 +540,126 @@ struct DenseRunResult {
   std::size_t live_lo = 1, live_hi = 0;
 };
 
+// Which nodes of row iy's span x0..x1 a dense pass visits, as bits in MUST: on a contiguous
+// store, in an interior row, the interior nodes (skip_lo..skip_hi) classed unstable, or all of
+// them where the row is not classed (class_row: the same heights without the classing's cost);
+// every other node of the span. (A transfer adds the nodes within two columns later: those
+// that read its writes.)
+struct RowClassing {
+  std::size_t skip_lo = 1, skip_hi = 0;  // nodes classed (empty: none)
+  bool classed = false;
+};
+template <int N, bool Gradient, Lanes lanes, class RowStore>
+[[gnu::always_inline]] inline RowClassing flag_span(const RowStore& rs, const ErosionTables& t, const NodeClass& middle,
+                                                    std::size_t row_k, std::size_t iy, std::size_t x0, std::size_t x1,
+                                                    bool y_up, bool class_row, bool windowed, std::uint64_t* must) {
+  const std::size_t nx = t.layout().nx, ny = t.layout().ny;
+  RowClassing c;
+  if constexpr (requires { rs.data(); }) {
+    if (iy > 0 && iy + 1 < ny && nx >= 3) {
+      c.skip_lo = std::max<std::size_t>(1, x0);
+      c.skip_hi = std::min(nx - 2, x1);
+      if (c.skip_lo <= c.skip_hi) {
+        const auto* row = rs.data() + row_k;
+        // The row after the next one, fetched while this one is classed: its first reads come
+        // in the next row's classing, a row of visits from now (a large grid streams its rows
+        // from memory; without this the classing waits for them). A hint: no result changes.
+        const std::size_t ahead = y_up ? iy + 2 : iy - 2;  // wraps below 0: past the grid
+        const auto w = static_cast<std::ptrdiff_t>(nx);
+        const auto* fetch = windowed || ahead >= ny ? nullptr : row + (y_up ? 2 * w : -2 * w);
+        c.classed = class_row;
+        if (!class_row) {  // every node flagged: the same heights, without the classing's cost
+          set_bits(must, c.skip_lo, c.skip_hi);
+          constexpr std::size_t kLine = 64 / sizeof(*row);  // heights per cache line
+          if (fetch != nullptr)
+            for (std::size_t x = c.skip_lo; x <= c.skip_hi + kLine - 1; x += kLine)
+              __builtin_prefetch(fetch + std::min(x, c.skip_hi));
+        } else {
+          const RowThresholds<N> th(middle, t.tan_settle() * t.tan_settle());
+          if (lanes == Lanes::Avx512)
+            unstable_bits_avx512<N, Gradient>(row, nx, c.skip_lo, c.skip_hi, th, must, fetch);
+          else if (lanes == Lanes::Avx2)
+            unstable_bits_avx2<N, Gradient>(row, nx, c.skip_lo, c.skip_hi, th, must);
+          else
+            unstable_bits<N, Gradient>(row, nx, c.skip_lo, c.skip_hi, th, must);
+        }
+      }
+    }
+  }
+  if (c.skip_lo > c.skip_hi) {
+    set_bits(must, x0, x1);
+  } else {
+    if (x0 < c.skip_lo) set_bits(must, x0, c.skip_lo - 1);
+    if (x1 > c.skip_hi) set_bits(must, c.skip_hi + 1, x1);
+  }
+  return c;
+}
+
+// A row's span as the phases see it: x0..x1, the interior four_lo..four_hi where groups of
+// lanes may run, the row's first node row_k on the store, the direction, and whether groups run.
+struct PhaseSpan {
+  std::size_t x0, x1, four_lo, four_hi, row_k;
+  bool x_up, in_groups;
+};
+
+// One phase of a row (the columns x = r (mod 3) of the span, in the sweep's direction): each
+// node flagged in MUST visited, on a contiguous store up to eight (AVX-512) or four (AVX2) at
+// once in the span's interior. group_transferred(a, bits, given, width, transfers) and
+// visit(ix) are dense_rows' bookkeeping; covered and idle count the nodes visited and those
+// that moved nothing.
+template <int N, bool Gradient, Lanes lanes, class RowStore, class Group, class Visit>
+[[gnu::always_inline]] inline void visit_phase(RowStore& rs, const ErosionTables& t, const NodeClass& middle,
+                                               const std::uint64_t* must, const PhaseSpan& s, std::size_t r,
+                                               std::size_t& covered, std::size_t& idle, Group& group_transferred,
+                                               Visit& visit) {
+  const std::size_t nx = t.layout().nx;
+  const std::size_t x0 = s.x0, x1 = s.x1, four_lo = s.four_lo, four_hi = s.four_hi, row_k = s.row_k;
+  const bool x_up = s.x_up, in_groups = s.in_groups;
+  std::size_t from = x_up ? x0 : x1;  // the next node of the phase may be here or beyond
+  std::size_t ix;
+  while (x_up ? next_in_class(must, r, from, x1, ix) : prev_in_class(must, r, x0, from, ix)) {
+    const std::size_t lowest = x_up ? ix : ix - std::min<std::size_t>(ix, 9);
+    if constexpr (requires { rs.data(); }) {
+      // Up to eight nodes of the phase from ix on, in the span's interior (AVX-512).
+      const std::size_t room = !in_groups || lanes != Lanes::Avx512 || ix < four_lo || ix > four_hi ? 0
+                               : x_up ? (four_hi - ix) / 3 + 1
+                                      : (ix - four_lo) / 3 + 1;
+      if (room >= 2) {
+        const std::size_t count = std::min<std::size_t>(8, room);
+        const std::size_t a = x_up ? ix : ix - 3 * (count - 1);
+        double given[8];
+        std::size_t transfers = 0;
+        covered += count;
+        if (const unsigned b =
+                erosion_visit8<N, Gradient>(rs, t, nx, row_k + a, count, middle, !x_up, given, transfers))
+          group_transferred(a, b, given, 8, transfers);
+        else
+          idle += count;
+        const std::size_t last = x_up ? a + 3 * (count - 1) : a;
+        if (x_up ? last >= x1 : last <= x0) break;
+        from = x_up ? last + 1 : last - 1;
+        continue;
+      }
+      if (in_groups && lanes == Lanes::Avx2 && lowest >= four_lo && lowest + 9 <= four_hi) {
+        double given[4];
+        std::size_t transfers = 0;
+        covered += 4;
+        if (const unsigned b = erosion_visit4<N, Gradient>(rs, t, row_k + lowest, middle, !x_up, given, transfers))
+          group_transferred(lowest, b, given, 4, transfers);
+        else
+          idle += 4;
+        const std::size_t last = x_up ? lowest + 9 : lowest;
+        if (x_up ? last >= x1 : last <= x0) break;
+        from = x_up ? last + 1 : last - 1;
+        continue;
+      }
+    }
+    visit(ix);
+    if (x_up ? ix >= x1 : ix <= x0) break;
+    from = x_up ? ix + 1 : ix - 1;
+  }
+}
+
 // One dense pass, in place (Gauss-Seidel), rows in the direction the active set's next
 // sweep would take: in each row, every node from the first to the last member (the row's
 // span) is visited once. Like the active-set sweep it is live: a row's span also covers the
@@ -600,9 +694,9 @@ struct DenseRunResult {
 // itself a choice that changes no height: a row is classed only where the row before showed it
 // pays (its visits left more than an eighth of its span out, or, not classed, more than an
 // eighth of its nodes were visited for nothing); otherwise every node of the row is flagged.
-// On grid_bench's pile and stroke, where nearly every group of eight nodes of a phase holds one
-// that moves, the classing fell from ~10 % of the time to under 1 %; on its all-active dunes,
-// where whole stretches of a row stay put, most rows are still classed.
+// On states where nearly every group of eight nodes of a phase holds one that moves (grid_bench's
+// pile and stroke) most rows go unclassed; where whole stretches of a row stay put (its
+// all-active dunes) most rows are still classed.
 //
 // Cost: O(span nodes) per pass -- the classing vectorised over the row, one visit per
 // unstable node -- plus O(words of the visited rows) to find the spans and update the set.
@@ -629,10 +723,8 @@ inline void dense_rows(Store& store, const Active& active, const typename Active
       return store;
   }
   ();
-  constexpr bool kContiguous = requires { rs.data(); };
   // The row's unstable nodes, one bit each (plus a word: or_bits may write one past the row).
   std::vector<std::uint64_t> flags(words + 1, 0);
-  [[maybe_unused]] const auto w = static_cast<std::ptrdiff_t>(nx);
   // Whether this row is classed. The classing costs about a third of a group's visit per eight
   // nodes and saves the groups whose nodes are all stable; where the row before left few such
   // nodes out of its visits, the next row is visited whole (every node flagged: the same heights
@@ -659,53 +751,16 @@ inline void dense_rows(Store& store, const Active& active, const typename Active
     prev_lo = 1, prev_hi = 0;
     if (!members && !live) continue;  // a row inside the members' rows with none
     const NodeClass& middle = t.of(nx / 2, iy);
-    // The nodes of the span that must be visited: on a contiguous store, in an interior row,
-    // the interior nodes classed unstable; every other node of the span. A transfer adds the
-    // nodes within two columns (those that read its writes).
     std::uint64_t* must = flags.data();
     std::fill(flags.begin() + static_cast<std::ptrdiff_t>(x0 / 64),
               flags.begin() + static_cast<std::ptrdiff_t>(x1 / 64 + 2), std::uint64_t{0});
-    std::size_t skip_lo = 1, skip_hi = 0;  // nodes classed (empty: none)
-    bool classed = false;
     // The row's first node on the store it runs on.
     const std::size_t row_k = kWindowed ? nx : iy * nx;
     if constexpr (kWindowed) window.load(iy, x0 > 0 ? x0 - 1 : 0, std::min(x1 + 1, nx - 1));
-    if constexpr (kContiguous) {
-      if (iy > 0 && iy + 1 < ny && nx >= 3) {
-        skip_lo = std::max<std::size_t>(1, x0);
-        skip_hi = std::min(nx - 2, x1);
-        if (skip_lo <= skip_hi) {
-          const auto* row = std::as_const(rs).data() + row_k;
-          // The row after the next one, fetched while this one is classed: its first reads come
-          // in the next row's classing, a row of visits from now (a large grid streams its rows
-          // from memory; without this the classing waits for them). A hint: no result changes.
-          const std::size_t ahead = y_up ? iy + 2 : iy - 2;  // wraps below 0: past the grid
-          const auto* fetch = kWindowed || ahead >= ny ? nullptr : row + (y_up ? 2 * w : -2 * w);
-          classed = class_row;
-          if (!class_row) {  // every node flagged: the same heights, without the classing's cost
-            set_bits(must, skip_lo, skip_hi);
-            constexpr std::size_t kLine = 64 / sizeof(*row);  // heights per cache line
-            if (fetch != nullptr)
-              for (std::size_t x = skip_lo; x <= skip_hi + kLine - 1; x += kLine)
-                __builtin_prefetch(fetch + std::min(x, skip_hi));
-          } else {
-            const RowThresholds<N> c(middle, t.tan_settle() * t.tan_settle());
-            if (lanes == Lanes::Avx512)
-              unstable_bits_avx512<N, Gradient>(row, nx, skip_lo, skip_hi, c, must, fetch);
-            else if (lanes == Lanes::Avx2)
-              unstable_bits_avx2<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
-            else
-              unstable_bits<N, Gradient>(row, nx, skip_lo, skip_hi, c, must);
-          }
-        }
-      }
-    }
-    if (skip_lo > skip_hi) {
-      set_bits(must, x0, x1);
-    } else {
-      if (x0 < skip_lo) set_bits(must, x0, skip_lo - 1);
-      if (x1 > skip_hi) set_bits(must, skip_hi + 1, x1);
-    }
+    const RowClassing rc = flag_span<N, Gradient, lanes>(std::as_const(rs), t, middle, row_k, iy, x0, x1, y_up,
+                                                         class_row, kWindowed, must);
+    const std::size_t skip_lo = rc.skip_lo, skip_hi = rc.skip_hi;
+    const bool classed = rc.classed;
     std::size_t row_lo = nx, row_hi = 0;  // span of this row's transfers (empty)
     std::size_t covered = 0;              // nodes visited, the lanes of groups included
     std::size_t idle = 0;                 // those of them in groups or visits that moved nothing
@@ -745,52 +800,10 @@ inline void dense_rows(Store& store, const Active& active, const typename Active
     // store, four nodes of a phase at once where they are interior nodes of the span.
     const bool in_groups = (lanes == Lanes::Avx512 || lanes == Lanes::Avx2) && skip_lo <= skip_hi && nx >= 13;
     const std::size_t four_lo = std::max<std::size_t>(x0, 2), four_hi = std::min(x1, nx - 3);
-    for (std::size_t p = 0; p < 3; ++p) {
-      const std::size_t r = x_up ? (x0 + p) % 3 : (x1 + 3 - p) % 3;
-      std::size_t from = x_up ? x0 : x1;  // the next node of the phase may be here or beyond
-      std::size_t ix;
-      while (x_up ? next_in_class(must, r, from, x1, ix) : prev_in_class(must, r, x0, from, ix)) {
-        const std::size_t lowest = x_up ? ix : ix - std::min<std::size_t>(ix, 9);
-        if constexpr (kContiguous) {
-          // Up to eight nodes of the phase from ix on, in the span's interior (AVX-512).
-          const std::size_t room = !in_groups || lanes != Lanes::Avx512 || ix < four_lo || ix > four_hi ? 0
-                                   : x_up ? (four_hi - ix) / 3 + 1
-                                          : (ix - four_lo) / 3 + 1;
-          if (room >= 2) {
-            const std::size_t count = std::min<std::size_t>(8, room);
-            const std::size_t a = x_up ? ix : ix - 3 * (count - 1);
-            double given[8];
-            std::size_t transfers = 0;
-            covered += count;
-            if (const unsigned b =
-                    erosion_visit8<N, Gradient>(rs, t, nx, row_k + a, count, middle, !x_up, given, transfers))
-              group_transferred(a, b, given, 8, transfers);
-            else
-              idle += count;
-            const std::size_t last = x_up ? a + 3 * (count - 1) : a;
-            if (x_up ? last >= x1 : last <= x0) break;
-            from = x_up ? last + 1 : last - 1;
-            continue;
-          }
-          if (in_groups && lanes == Lanes::Avx2 && lowest >= four_lo && lowest + 9 <= four_hi) {
-            double given[4];
-            std::size_t transfers = 0;
-            covered += 4;
-            if (const unsigned b = erosion_visit4<N, Gradient>(rs, t, row_k + lowest, middle, !x_up, given, transfers))
-              group_transferred(lowest, b, given, 4, transfers);
-            else
-              idle += 4;
-            const std::size_t last = x_up ? lowest + 9 : lowest;
-            if (x_up ? last >= x1 : last <= x0) break;
-            from = x_up ? last + 1 : last - 1;
-            continue;
-          }
-        }
-        visit(ix);
-        if (x_up ? ix >= x1 : ix <= x0) break;
-        from = x_up ? ix + 1 : ix - 1;
-      }
-    }
+    const PhaseSpan ps{x0, x1, four_lo, four_hi, row_k, x_up, in_groups};
+    for (std::size_t p = 0; p < 3; ++p)
+      visit_phase<N, Gradient, lanes>(rs, t, middle, must, ps, x_up ? (x0 + p) % 3 : (x1 + 3 - p) % 3, covered, idle,
+                                      group_transferred, visit);
     // Past the span's end while the node at the end transferred (its block reaches one node further).
     // (A window holds columns x0 - 1 .. x1 + 1 from its load: only these visits reach beyond.)
     if (x_up) {

@@ -51,8 +51,8 @@
 // between rows (grid_bench's widths are powers of two): 510 and 2046 nodes wide instead of 512
 // and 2048 ran 0.99 / 0.99 / 1.02. This virtual machine has no hardware counters; the next step
 // is where those stores stall.
-// Valgrind runs no AVX-512, so there are no callgrind counts for these paths:
-// erosion_kernel.hpp's header gives their measured throughput.
+// Valgrind runs no AVX-512, so there are no callgrind counts for these paths: measure their
+// throughput with tests/bench/grid_bench.cpp (erosion_kernel.hpp's header says what it runs).
 #include <immintrin.h>
 
 #include <algorithm>

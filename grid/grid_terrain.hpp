@@ -43,35 +43,18 @@
 //   stats                       O(1)
 // Each stamp and erode reports its exact volume change (volume_change_m3: the stamp's own
 // sums, and the rounding carry), so the runner never integrates the grid per step.
-// Measured (tests/bench/grid_bench.cpp, a loaded 2-vCPU VM, CPU time, medians of 3 runs of
-// 3 repetitions, main and this kernel interleaved), node updates per second (one update =
-// the rule evaluated at one node) and time per call of 64 passes:
-//                        main               this kernel (dense pass over the row spans)
-//   pile,   double       23.5 M/s  3.16 ms  36.6 M/s  2.04 ms
-//   stroke, double       26.6 M/s  8.48 ms  52.8 M/s  4.64 ms
-//   pile,   float        19.6 M/s  3.80 ms  30.2 M/s  2.47 ms
-//   stroke, float        21.9 M/s 10.28 ms  42.3 M/s  5.78 ms
-// 2048^2 with every node active (steep dunes, 46 % of the nodes above the critical angle):
-// 78 M/s in double, 61 M/s in float, against 16.0 and 15.5 M/s for the plain scalar
-// reference sweep of the same rule in the same run (BM_ReferenceSweep): 4.9x and 3.9x.
-// On these states most visited nodes transfer, and a transferring visit costs ~180
-// instructions (8 neighbours); the vector classing only saves the visits of stable nodes.
-// A stamp ~80 ns per node of its window, e.g. 3 ms for a 64-cell (32 cm) disk.
-// Settling (relax_at_end) alone is diffusive near the critical angle: on flat_stroke.toml
-// the passes to settle grow 3.4-3.8x per halving of the cell (163, 552, 2077 at 2.5, 1.25,
-// 0.625 mm); neither a larger transfer fraction (1.9: 49, 157, 537 passes) nor the ordered
-// or dense sweeps change that exponent, they only make each pass cheaper. Settling budgets
-// (32 passes or more, 1024 active nodes or more) therefore start with a coarse-to-fine
-// cascade (multires_settle.hpp) that moves the sand over long distances on coarse copies of
-// the grid before the fine passes finish: O(box around the active set) per call, plus the
-// coarse levels' visits. Stroke and settling of flat_stroke.toml at 0.32, 1.3 and 5.1 M
-// nodes, medians of 3 runs interleaved with main (loaded 2-vCPU VM): gradient rule 0.094,
-// 0.44, 2.0 s (main 0.29, 4.2, 53.6 s), edge rule 0.048, 0.21, 1.02 s (main 0.097, 1.32,
-// 19.8 s): time grows as n^1.11 for both rules (main n^1.9). Settling's updates at 5.1 M
-// nodes: 21.7 M in 10 calls of 64 passes (main: 727 M in 254), edge rule 18.2 M in 7 (main:
-// 503 M in 127). Volume drift 0; trench walls (trench_azimuth.toml, 9 azimuths, 8
-// neighbours, gradient rule) 30.075 degrees on average, every section within 0.16 of 30
-// (fine passes alone: 30.080, 0.16).
+// Node updates per second and the time per call of each pass are measured by
+// tests/bench/grid_bench.cpp (`make bench`; BM_ReferenceSweep is the plain scalar sweep of the
+// same rule, the baseline of the vector pass); results/settling.md has the stroke and settling
+// times against resolution of the last reproduction. On a stroke's states most visited nodes
+// transfer, so the vector classing saves only the visits of stable nodes.
+// Settling (relax_at_end) with fine passes alone is diffusive near the critical angle: the
+// passes to settle grow about as (L / h)^2 with the cell h, and neither a larger transfer
+// fraction nor another sweep order changes that exponent, they only make each pass cheaper.
+// Settling budgets (32 passes or more, 1024 active nodes or more) therefore start with a
+// coarse-to-fine cascade (multires_settle.hpp) that moves the sand over long distances on
+// coarse copies of the grid before the fine passes finish: O(box around the active set) per
+// call, plus the coarse levels' visits.
 // See README, "The three back-ends at a glance".
 #include <functional>
 #include <memory>

@@ -30,10 +30,9 @@
 // shifted by the block's change; the fine passes then settle the detail locally. Rebuilding
 // the children from the coarse heights instead (a slope per block) replaces detail the fine
 // rule would have kept with flat or bumped blocks below the critical angle, which the rule,
-// moving sand only downhill, never undoes: measured on trench_azimuth.toml (grid, 8
-// neighbours, gradient rule), such rebuilds left the walls at 20-26 degrees instead of 30.
-// Piecewise-constant injection keeps them within 0.02 degrees of the fine passes alone
-// (grid_terrain.hpp has the figures).
+// moving sand only downhill, never undoes: on trench_azimuth.toml such rebuilds leave the walls
+// degrees flatter than critical, where piecewise-constant injection leaves them where the fine
+// passes alone do (tests/unit/grid_multires_test.cpp checks the cascade against the fine passes).
 //
 // Conservation. A coarse transfer of V from I to J changes Z_I by -V / A_I and Z_J by
 // V / A_J (the kernel's pairwise transfer, with the level's areas); adding dZ_I to every
@@ -77,8 +76,8 @@
 // Cost: O(box) to restrict and inject, plus the levels' visits (each level's active set:
 // the nodes above fine members and around changes); memory per coarse node 8 bytes for the
 // height, 8 for the restricted height, 1 flag and the coarse active set's ~2 bytes, about a
-// third of the box's nodes in all, freed on return. Measured on flat_stroke.toml: see
-// grid_terrain.hpp.
+// third of the box's nodes in all, freed on return. What it saves: results/settling.md and
+// results/cascade.md.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>

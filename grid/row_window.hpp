@@ -43,14 +43,11 @@
 // rows each row is read once and written back once, O(its columns): the union of the spans of
 // the (at most three) visited rows whose window held it; every kRows - 2 slides the two kept
 // rows are copied, O(their columns); load / extend O(the columns they add), flush O(columns
-// held), z / put O(1). The window this replaces read all three rows and wrote all three back
-// for every visited row. Measured (callgrind, AVX2 lanes, instructions of erode_ordered per
-// run of the scene, relax_at_end off; the scenes' gradient rule, 8 neighbours): trench 125.0 M
-// with the window this replaces, 103.1 M now, the dense grid 96.1 M (1.30x -> 1.07x the dense
-// grid); pile 28.6 -> 23.3 M (dense 21.1: 1.35x -> 1.10x); flat_stroke 9.92 -> 7.96 M (dense
-// 6.86: 1.44x -> 1.16x). Of the 7.0 M left on trench, 6.4 M are the window's reads and
-// write-backs (SparseHeights::read_row / write_changed, O(8) per block row), 0.4 M the paged
-// active set.
+// held), z / put O(1). Sliding, a pass reads and writes each row once instead of three times;
+// what the sparse grid still pays over the dense one is mostly these reads and write-backs
+// (SparseHeights::read_row / write_changed, O(8) per block row). How to measure: callgrind's
+// instructions of erode_ordered on the same scene with `--backend sparse` and `grid`, or
+// tests/bench/sparse_bench.cpp.
 #include <algorithm>
 #include <cstddef>
 #include <cstring>

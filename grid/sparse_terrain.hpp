@@ -14,22 +14,22 @@
 //   fixed: the tree object 1.2 KB, a 544-byte internal node per 32 x 128 nodes that hold a
 //   leaf or tile, 64 * sizeof(Real) per distinct tile height, and the erosion tables the
 //   dense grid has too (up to 25 node classes, 14 KB).
-// Measured at the end of the shipped scenes (tests/unit/sparse_terrain_test.cpp), against
-// the dense grid: flat_stroke 35 KB (0.16), pile 30 KB (0.19), trench 58 KB (0.39: a
-// quarter of its nodes are disturbed), dunes, where every node differs, 166 KB (0.95).
+// So its memory follows the disturbed area in whole blocks: a local stroke on a flat bed needs
+// a fraction of the dense grid's bytes, a terrain where every node differs about as many
+// (tests/unit/sparse_terrain_test.cpp bounds the ratios; results/sparse.md has this run's).
 //
 // Each stamp and erode reports its exact volume change (volume_change_m3: the stamp's own
 // sums and the rounding carry, as on the dense grid), so the runner never integrates it per
-// step. The dense erosion pass visits every node of its spans here (no contiguous rows to
-// class with vector arithmetic), with the same heights as the dense grid's, bit for bit.
+// step. The dense erosion pass runs the dense grid's code on a RowWindow (row_window.hpp), a
+// contiguous copy of the rows it touches that slides from row to row, so it classes rows and
+// visits nodes in the same vector lanes, with the same heights as the dense grid's, bit for bit.
 // Costs: those of GridTerrain (grid_terrain.hpp), each height read or write O(1) through
 // the block table (a multiply-high for the row, a few shifts, two loads; a write one branch
 // more), a write to a uniform block O(64) once to create its leaf; when erosion settles
 // (the active set empties), O(64) per block written since the last settle to prune uniform
-// blocks back to tiles. Measured against the dense grid (tests/bench/sparse_bench.cpp,
-// medians of 9 interleaved runs): per-step time p50 1.20x (flat_stroke) to 1.41x (pile),
-// settling up to 1.55x (pile). OpenVDB's headers stay in sparse_heights.cpp (21 s of CPU
-// to compile, 0.85 GB).
+// blocks back to tiles. tests/bench/sparse_bench.cpp measures its step and settling times
+// against the dense grid's. OpenVDB's headers stay in sparse_heights.cpp (they are slow and
+// memory-hungry to compile).
 #include <functional>
 #include <memory>
 

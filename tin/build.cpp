@@ -35,26 +35,39 @@ double tool_radius(const ToolSpec& t) {
 
 }  // namespace
 
-double default_refine_m(const Scene& scene) {
+TinOptions tin_options(const Scene& scene) {
+  TinOptions o;
+  o.domain = scene.domain;
+  o.tin = scene.tin;
+  o.idle_passes = scene.erosion.idle_passes;
+  o.settle_tolerance_deg = scene.erosion.settle_tolerance_deg;
+  o.material = scene.material;
+  o.tool_radius_m = tool_radius(scene.tool);
+  o.kind = scene.terrain.kind;
+  o.base_height_m = scene.terrain.height_m;
+  return o;
+}
+
+double default_refine_m(const TinOptions& o) {
   // Linear interpolation over an edge of length h across a slope break of tan(critical)
   // (a pile's toe and apex, a wall's foot) errs by at most h tan / 4: the edge length at
   // which the surface stays within tin.tolerance_m. Never finer than half the tool's radius
   // (what a stamp resolves anyway; finer, erosion over a whole dune field refines it all),
   // never coarser than 5 % of the domain.
-  const double extent = std::max(scene.domain.size_m.x(), scene.domain.size_m.y());
-  const double tan_c = scene.material.tan_critical();
-  const double h = tan_c > 0.0 ? 4.0 * scene.tin.tolerance_m / tan_c : extent;
-  return std::min(std::max(h, 0.5 * tool_radius(scene.tool)), 0.05 * extent);
+  const double extent = std::max(o.domain.size_m.x(), o.domain.size_m.y());
+  const double tan_c = o.material.tan_critical();
+  const double h = tan_c > 0.0 ? 4.0 * o.tin.tolerance_m / tan_c : extent;
+  return std::min(std::max(h, 0.5 * o.tool_radius_m), 0.05 * extent);
 }
 
-TinTerrain::TinTerrain(const Scene& scene)
-    : domain_(scene.domain), box_(scene.domain.box()), spec_(scene.tin), idle_passes_(scene.erosion.idle_passes) {
+TinTerrain::TinTerrain(const TinOptions& o)
+    : domain_(o.domain), box_(o.domain.box()), spec_(o.tin), idle_passes_(o.idle_passes) {
   const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
   if (!(domain_.size_m.minCoeff() > 0.0) || !std::isfinite(extent))
     throw InputError("scene: domain.size_m must be positive and finite for the TIN");
-  tool_size_m_ = tool_radius(scene.tool);
+  tool_size_m_ = o.tool_radius_m;
   if (!(tool_size_m_ > 0.0) || !std::isfinite(tool_size_m_)) tool_size_m_ = 0.02 * extent;
-  refine_m_ = spec_.refine_m > 0.0 ? spec_.refine_m : default_refine_m(scene);
+  refine_m_ = spec_.refine_m > 0.0 ? spec_.refine_m : default_refine_m(o);
   // Never split below what snapping could merge again, nor below a ten-thousandth of the
   // domain (a 0.4 mm tool must not refine a 30 cm domain to 0.1 mm).
   const double floor_m = std::max(64.0 * spec_.snap_m, 1e-4 * extent);
@@ -67,10 +80,10 @@ TinTerrain::TinTerrain(const Scene& scene)
   fine_m_ = curvature_tolerance_m_ > 0.0 ? std::clamp(fine, 0.25 * refine_m_, refine_m_) : refine_m_;
   // A thousandth of the TIN's accuracy: what coarsening may add to an edge's height drop.
   settle_dz_ = 1e-3 * spec_.tolerance_m;
-  tan_critical_ = scene.material.tan_critical();
-  tan_settle_ = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg).tan_settle;
-  kind_ = scene.terrain.kind;
-  base_height_m_ = scene.terrain.height_m;
+  tan_critical_ = o.material.tan_critical();
+  tan_settle_ = ErosionRule::from(o.material, o.settle_tolerance_deg).tan_settle;
+  kind_ = o.kind;
+  base_height_m_ = o.base_height_m;
 }
 
 void TinTerrain::insert_corners(const std::function<double(const Vec2&)>& z) {
@@ -280,17 +293,17 @@ std::unique_ptr<Terrain> make_tin_terrain(const Scene& scene, const HeightField&
     for (const Vec2& p : jittered_lattice(scene.domain, static_cast<std::size_t>(scene.tin.initial_points),
                                           scene.tin.initial_jitter, static_cast<std::uint64_t>(scene.terrain.seed)))
       points.emplace_back(p.x(), p.y(), initial(p));
-    auto t = std::make_unique<detail::TinTerrain>(scene);
+    auto t = std::make_unique<detail::TinTerrain>(detail::tin_options(scene));
     t->build_from_points(points, &initial);
     return t;
   }
-  auto t = std::make_unique<detail::TinTerrain>(scene);
+  auto t = std::make_unique<detail::TinTerrain>(detail::tin_options(scene));
   t->build_from_field(initial);
   return t;
 }
 
 std::unique_ptr<Terrain> make_tin_terrain_from_points(const Scene& scene, const std::vector<Vec3>& points) {
-  auto t = std::make_unique<detail::TinTerrain>(scene);
+  auto t = std::make_unique<detail::TinTerrain>(detail::tin_options(scene));
   t->build_from_points(points);
   return t;
 }

@@ -12,11 +12,9 @@
 // gives it; a point on a vertex gets the vertex's height, as height() does; a point on an
 // edge gets the interpolation of either face, as height()'s walk may end in either (they
 // agree to rounding, a few units in the last place).
-// Measured: trench.toml's 1 mm raster (80.6k points, 1.4k vertices; callgrind) 1,040
-// instructions a point walking, 225 rasterising; tests/bench/tin_query_bench.cpp's whole-domain
-// 2.5 mm raster (80k points; CPU medians of 3): 11.1 -> 2.7 ms on 10^4 vertices, 20.3 -> 10.6-11.3
-// ms on 10^5 (whose faces outnumber the points 2.5 to 1: the faces' loop waits on memory), and
-// 10^6 walks as before (84-88 ms; rasterising 2 M faces would cost about as much).
+// Rasterising face by face costs a few times fewer instructions a point than walking to each
+// point, until the faces outnumber the points (then the faces' loop waits on memory), so very
+// large TINs walk. tests/bench/tin_query_bench.cpp measures both on 10^4 to 10^6 vertices.
 #include <algorithm>
 #include <cmath>
 #include <limits>

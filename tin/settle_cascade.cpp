@@ -193,9 +193,9 @@ void relax_fine(std::span<double> z, std::span<const double> area, std::span<con
   // laid out once, a visit only reads the heights in. So are the fan gradient's coefficients
   // (fan_gradient_coefficients: it is linear in the height differences), where the rule does
   // not cap drops; capped drops need the steepest facet, so the facets are computed one by one
-  // (fan_gradient), as TinTerrain::erode does. Measured before the TIN capped at rest
-  // (callgrind, flat_stroke.toml with tool.depth_m = 0.2, same visits): 117 M instructions in
-  // the fine level with the per-visit geometry, 88 M with it laid out.
+  // (fan_gradient), as TinTerrain::erode does; laid out once per star, the fine level's visits
+  // do not recompute the ring's geometry (callgrind on flat_stroke.toml with tool.depth_m = 0.2
+  // counts the difference).
   const bool gradient = rule.needs_gradient();
   const bool linear_gradient = gradient && !rule.cap_drop;
   std::vector<ErosionNeighbour> nbrs(ring.size());

@@ -86,11 +86,9 @@
 // Cost: O(region x degree) to gather the region (a hash lookup per edge end), O(region) per
 // level to restrict and inject, plus the levels' visits (at most max_passes_per_level passes
 // each, max_fine_passes on the fine level; counted as updates, the call as one pass); memory
-// about 600 B per region vertex (the fine level's laid-out rings), freed on return. Measured
-// (flat_stroke.toml, tool.depth_m = 0.2, medians of 9 interleaved runs against the code before
-// the cascade): settling 361k updates in 56 ms before, 136k updates (clusters, fine level and
-// the TIN's closing passes) in 16 ms after; stroke + settling 16.9x the grid's before, 8.5x
-// after. The other shipped scenes: 17-41 % fewer settling updates (pile.toml: no cascade).
+// about 600 B per region vertex (the fine level's laid-out rings), freed on return. What it
+// saves: results/cascade.md (the deep stroke's settling updates and time with and without it,
+// `erosion.cascade`), measured again by every reproduction.
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -145,8 +143,8 @@ struct CascadeOptions {
   // A node leaves its level's active set after this many idle visits. One suffices: every
   // change that can make a node unstable re-activates it (a giver its whole ring, a receiver
   // itself, and under the gradient rule its ring, whose fan gradients read it), and the TIN's
-  // passes check every vertex the cascade changed anyway. Measured against 2: 14-25 % fewer
-  // settling updates on the shipped scenes, trench walls unchanged within 0.02 degrees.
+  // passes check every vertex the cascade changed anyway, so a second idle visit only adds
+  // updates (compare the shipped scenes' settling updates with 2 to see it).
   int idle_passes = 1;
   int max_levels = 10;
   bool measure_energy = false;

@@ -131,9 +131,8 @@ SimplifyReport TinTerrain::simplify(const SimplifyParams& params) {
   // planar rule, and the flat rule over every vertex) acts only while the whole terrain is at
   // rest (L_e empty): a region that settled between two stamps is usually flowed over again by
   // the next one (a growing pile's flank and the bed around it, a trench's rim), and erosion
-  // would refine it again right after (measured on pile.toml when settled vertices were
-  // coarsened between pours: 57 more edge splits, 6 % more erosion updates and a 25 % slower
-  // step than without coarsening). The first simplification at rest after any activity scans
+  // would refine it again right after (coarsening between a pile's pours costs more edge
+  // splits and erosion updates than it saves). The first simplification at rest after any activity scans
   // every vertex once (O(n)); removals queue their links, cascading until nothing more is
   // redundant.
   const bool at_rest = erosion_list_.empty();
@@ -250,8 +249,8 @@ void TinTerrain::simplify_round(double tan_alpha, bool coarsen, bool scan_all, S
     if (coarsen && has_steep_triangle(link, false)) {
       // Coarsening: a triangle of the hole, or one the give-back tilted around it, is steeper
       // than the stable slope (triangles can be steeper than all their edges; a short edge at
-      // a rim is tilted by the give-back: measured on trench.toml, 17 such edges left 3.6
-      // degrees of slope excess). Undo: the old heights and the same point give back the same
+      // a rim is tilted by the give-back, which on a trench's rim leaves degrees of slope
+      // excess). Undo: the old heights and the same point give back the same
       // Delaunay triangulation, so the surface is restored (up to cocircular ties and
       // rounding: what the removal and the reinsertion leave is measured and given back to v).
       for (std::size_t k = 0; k < link.size(); ++k) shift_z(link[k], link_z[k], cached_area(link[k]));

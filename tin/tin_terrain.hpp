@@ -67,8 +67,8 @@
 // goes (O and I lie a contour gap apart, far below the mesh's resolution, and two such small
 // areas throttled every transfer across the old wall). A tool deeper than the bed stops at z = 0. Erosion re-activates
 // the giver's neighbours and the receivers; under the gradient rule also the receivers' neighbours, whose fan gradients
-// read the receiver's height (one ring there, measured: 7 % fewer visits on trench.toml, but the pile's flank settles
-// 0.7 degrees further from critical); tan_settle is its settling criterion. A stamp re-activates the vertices whose
+// read the receiver's height (re-activating only the giver's ring visits less, but leaves the pile's flank further from
+// critical); tan_settle is its settling criterion. A stamp re-activates the vertices whose
 // heights it changed with their neighbours, and of the rest of the retriangulated region only vertices next to a face
 // steeper than critical. Not thread-safe: height() and sample() move their walk hint (a walk of their own: what an
 // edit builds never depends on the queries made before it, tests/unit/tin_reproducible_test.cpp).

@@ -21,13 +21,10 @@ namespace sb::cli {
 
 namespace {
 struct CompareOptions {
-  std::string scene;
+  SceneInput in;  // SCENE, --set, --unset, --replay
   std::string backends;
   std::string out;
   bool json = false;
-  std::vector<std::string> overrides;
-  std::vector<std::string> unset;
-  std::string replay;  // a recorded session replayed on every back-end
 };
 
 std::vector<std::string> split(const std::string& s, char sep) {
@@ -86,9 +83,9 @@ void compare_command(const CompareOptions& o) {
     variants.push_back(parse_variant(item, "--backends"));
   if (variants.empty()) throw InputError("--backends is empty; give e.g. tin,grid");
   const std::filesystem::path dir = o.out;
-  if (!dir.empty()) check_output_directory(dir, "--out", {o.scene, o.replay});  // --out '' fails its validator
+  if (!dir.empty()) check_output_directory(dir, "--out", {o.in.scene, o.in.replay});  // --out '' fails its validator
 
-  PreparedScene prepared = prepare_input(o.scene, o.unset, o.overrides, o.replay);
+  PreparedScene prepared = prepare_input(o.in);
   // A folder being written holds this marker until its last picture is there, so a killed
   // compare leaves a folder that says it is incomplete.
   const std::filesystem::path marker = dir / "INCOMPLETE";
@@ -118,7 +115,7 @@ void compare_command(const CompareOptions& o) {
   const std::string table = markdown_table(runs);
   if (!dir.empty()) {
     for (const auto& r : runs)
-      write_run_file(dir / default_run_path(o.scene, r.run.label).filename(), r.run, r.prepared, r.summary);
+      write_run_file(dir / default_run_path(o.in.scene, r.run.label).filename(), r.run, r.prepared, r.summary);
     write_text_atomically(dir / "summary.json", report.dump(2) + "\n");
     write_text_atomically(dir / "table.md", table);
     std::vector<PictureRun> pictures;
@@ -144,17 +141,13 @@ void compare_command(const CompareOptions& o) {
 void add_compare_command(CLI::App& app) {
   auto opts = std::make_shared<CompareOptions>();
   CLI::App* cmd = app.add_subcommand("compare", "Run the same schedule on several back-ends and compare them");
-  cmd->add_option("scene", opts->scene, "Scene file (TOML)")->required();
+  add_scene_options(cmd, opts->in, ReplayOption::With);
   cmd->add_option("--backends", opts->backends,
                   "Comma-separated back-ends or variants (default tin,grid,sparse), e.g. grid,grid:grid.storage=float");
   cmd->add_option("--out", opts->out,
                   "Directory for run files, summary.json, table.md, side_by_side.png and difference.png")
       ->check(output_directory());
-  cmd->add_option("--replay", opts->replay,
-                  "Replay a session recorded by `sandbench interactive --record` on every back-end, side by side");
-  cmd->add_option("--unset", opts->unset, "Remove a scene key (before --set): --unset tool.radius_m")->take_all();
   cmd->add_flag("--json", opts->json, "Print the report as JSON on stdout");
-  cmd->add_option("--set", opts->overrides, "Override a scene key: --set tool.radius_m=0.03")->take_all();
   cmd->callback([opts] { compare_command(*opts); });
 }
 

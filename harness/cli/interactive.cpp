@@ -1,19 +1,22 @@
 // `sandbench interactive SCENE --backend tin|grid [--device mouse|replay:FILE|udp:PORT]
-//   [--record FILE] [--frames N --screenshot IMAGE.png --stats STATS.json] [--set k=v ...]`
+//   [--record FILE] [--frames N --screenshot IMAGE.png --stats STATS.json] [--set k=v ...] [--unset k ...]`
 #include <memory>
 
 #include "harness/cli/commands.hpp"
+#include "harness/cli/scene_input.hpp"
 #include "harness/cli/validators.hpp"
 #include "harness/run/backends.hpp"
+#include "harness/run/variant.hpp"
 #include "harness/window/options.hpp"
 
 namespace sb::cli {
 
 void add_interactive_command(CLI::App& app) {
   auto o = std::make_shared<InteractiveOptions>();
+  auto in = std::make_shared<SceneInput>();  // no --replay: the device replays (--device replay:FILE)
   CLI::App* cmd = app.add_subcommand(
       "interactive", "Touch the sand: a window, a tool driven by a haptic device (or the mouse), forces at 1 kHz");
-  cmd->add_option("scene", o->scene, "Scene file (TOML)")->required();
+  add_scene_options(cmd, *in, ReplayOption::Without);
   cmd->add_option("--backend", o->backend, backend_list() + " (optionally grid:key=value:...)")->required();
   cmd->add_option("--device", o->device, "mouse | replay:FILE (CSV t,x,y,z,buttons) | udp:PORT (loopback bridge)")
       ->capture_default_str();
@@ -24,7 +27,6 @@ void add_interactive_command(CLI::App& app) {
   cmd->add_option("--screenshot", o->screenshot, "Write the last frame to this PNG file")->check(output_file());
   cmd->add_option("--stats", o->stats, "Write the haptic statistics (servo_hz, tick_us.*, ...) to this JSON file")
       ->check(output_file());
-  cmd->add_option("--set", o->overrides, "Override a scene key: --set material.friction=0.6")->take_all();
   cmd->add_option("--max-force-n", o->max_force_n, "Device force limit, N")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -38,7 +40,9 @@ void add_interactive_command(CLI::App& app) {
   cmd->add_flag("!--no-realtime", o->realtime, "Do not ask for real-time (SCHED_FIFO) priority for the servo thread");
   auto size = std::make_shared<std::vector<int>>();
   cmd->add_option("--size", *size, "Window size: --size 1280 800")->expected(2)->check(CLI::Range(64, 8192));
-  cmd->callback([o, size] {
+  cmd->callback([o, in, size] {
+    o->scene = in->scene;
+    o->overrides = scene_overrides(in->unset, in->overrides);
     if (size->size() == 2) {
       o->width = (*size)[0];
       o->height = (*size)[1];

@@ -15,23 +15,20 @@ namespace sb::cli {
 
 namespace {
 struct RunOptions {
-  std::string scene;
+  SceneInput in;  // SCENE, --set, --unset, --replay
   std::string backend;
   std::string out;
   bool json = false;
-  std::vector<std::string> overrides;
-  std::vector<std::string> unset;
-  std::string replay;  // a recorded session whose stamps replace the scene's stroke
 };
 
 void run_command(const RunOptions& o) {
-  PreparedScene prepared = prepare_input(o.scene, o.unset, o.overrides, o.replay);
+  PreparedScene prepared = prepare_input(o.in);
   const Variant variant = parse_variant(o.backend, "--backend");
   const std::filesystem::path out =
-      o.out.empty() ? default_run_path(o.scene, variant.label) : std::filesystem::path(o.out);
-  check_output_path(out, "--out", {o.scene, o.replay});  // the default name too; --out '' fails its validator
+      o.out.empty() ? default_run_path(o.in.scene, variant.label) : std::filesystem::path(o.out);
+  check_output_path(out, "--out", {o.in.scene, o.in.replay});  // the default name too; --out '' fails its validator
   VariantRun r = run_variant(variant, prepared, /*show_progress=*/true);
-  if (!o.replay.empty()) r.summary["replay"] = o.replay;
+  if (!o.in.replay.empty()) r.summary["replay"] = o.in.replay;
   write_run_file(out, r.run, r.prepared, r.summary);
   if (o.json) {
     std::cout << r.summary.dump(2) << "\n";
@@ -45,14 +42,10 @@ void run_command(const RunOptions& o) {
 void add_run_command(CLI::App& app) {
   auto opts = std::make_shared<RunOptions>();
   CLI::App* cmd = app.add_subcommand("run", "Run one back-end on a scene's stroke and write an HDF5 run file");
-  cmd->add_option("scene", opts->scene, "Scene file (TOML)")->required();
+  add_scene_options(cmd, opts->in, ReplayOption::With);
   cmd->add_option("--backend", opts->backend, backend_list() + " (optionally grid:key=value:...)")->required();
   cmd->add_option("--out", opts->out, "Run file to write (default: <scene>-<backend>.h5)")->check(output_file());
   cmd->add_flag("--json", opts->json, "Print the summary as JSON on stdout");
-  cmd->add_option("--set", opts->overrides, "Override a scene key: --set tool.radius_m=0.03")->take_all();
-  cmd->add_option("--unset", opts->unset, "Remove a scene key (before --set): --unset tool.radius_m")->take_all();
-  cmd->add_option("--replay", opts->replay,
-                  "Replay a session recorded by `sandbench interactive --record`: its stamps are the schedule");
   cmd->callback([opts] { run_command(*opts); });
 }
 

@@ -1,5 +1,8 @@
 #pragma once
-// The scene a `run` or `compare` works on, from its options.
+// The scene a command works on, from its options: the positional SCENE, --set and --unset for
+// every command that takes a scene, and --replay for those that run a schedule (`run`,
+// `compare`). Defined here once, so the commands accept the same scene options.
+#include <CLI/CLI.hpp>
 #include <string>
 #include <vector>
 
@@ -7,11 +10,22 @@
 
 namespace sb::cli {
 
+struct SceneInput {
+  std::string scene;
+  std::vector<std::string> unset;      // --unset: keys removed before the --sets
+  std::vector<std::string> overrides;  // --set key=value
+  std::string replay;                  // --replay: a recorded session (empty: the scene's stroke)
+};
+
+enum class ReplayOption { Without, With };
+
+// Adds SCENE, --set and --unset (and --replay with ReplayOption::With) to CMD, filling IN.
+void add_scene_options(CLI::App* cmd, SceneInput& in, ReplayOption replay);
+
 // The scene file with --unset and --set applied; with --replay (non-empty), the session's stamps
 // replace the scene's stroke, its own overrides (its material) come before --set so that --set
 // still wins, its tools are validated against the scene, and the analytic references are off
 // (they follow the scene's stroke). Throws InputError naming the option on bad input.
-PreparedScene prepare_input(const std::string& scene, const std::vector<std::string>& unset,
-                            const std::vector<std::string>& overrides, const std::string& replay);
+PreparedScene prepare_input(const SceneInput& in);
 
 }  // namespace sb::cli

@@ -129,8 +129,6 @@ TEST(HapticsServoLoop, RunsBesideAPublisherAndKeepsForcesWithinLimits) {
   EXPECT_GT(s.forces_clamped, 0u);
   EXPECT_GT(s.ticks_in_contact, 0u);
   EXPECT_EQ(s.force_limit_n, 3.0);
-  EXPECT_LE(s.tick_us_p50, s.tick_us_p99);
-  EXPECT_LE(s.tick_us_p99, s.tick_us_max);
   EXPECT_GT(s.servo_hz, 0.0);
   EXPECT_GT(s.duration_s, 0.0);
   // Recording: every tick queued, in time order.

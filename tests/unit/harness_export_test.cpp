@@ -54,7 +54,7 @@ class Export : public test::TempDirTest {
 
 struct Ply {
   std::vector<std::string> header;
-  std::vector<std::array<double, 3>> vertices;  // double since issue 13 (UTM-sized coordinates)
+  std::vector<std::array<double, 3>> vertices;  // double: UTM-sized coordinates survive exactly
   std::vector<std::array<std::int32_t, 3>> faces;
   std::vector<std::array<std::int32_t, 2>> edges;
   std::vector<std::uint8_t> constrained;

@@ -80,8 +80,6 @@ void expect_safe_forces(const nlohmann::json& s) {
   EXPECT_LE(s["force_max_n"].get<double>(), limit);
   EXPECT_LE(s["device_force_max_n"].get<double>(), limit);
   EXPECT_GT(s["ticks"].get<double>(), 0.0);
-  EXPECT_LE(s["tick_us.p50"].get<double>(), s["tick_us.p99"].get<double>());
-  EXPECT_LE(s["tick_us.p99"].get<double>(), s["tick_us.max"].get<double>());
 }
 
 class Window : public ::testing::Test {

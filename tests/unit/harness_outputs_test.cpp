@@ -1,4 +1,4 @@
-// Trustworthy outputs (issue 13): user mistakes exit 2 with a message that names them, outputs
+// Trustworthy outputs: user mistakes exit 2 with a message that names them, outputs
 // never destroy inputs or special files, damaged run files are refused, warnings reach the
 // researcher, exports keep their precision, and a failing disk leaves nothing behind.
 #include <gtest/gtest.h>

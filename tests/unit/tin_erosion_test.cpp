@@ -85,7 +85,7 @@ TEST(TinErosion, IdleVerticesLeaveTheActiveSet) {
 TEST(TinErosion, APileOnTwoTrianglesRefinesAndRelaxesToACone) {
   // pile.toml with a coarser refinement, to stay fast: 4 pours of 5e-6 m^3. The edge rule:
   // with the gradient rule this TIN rests with a flat shoulder beside the top (every edge and
-  // fan gradient at or below critical, the top 5.8% low), an open problem (issue 10).
+  // fan gradient at or below critical, the top 5.8% low).
   const Scene s =
       scene(kPileScene, {"stroke.repeat=4", "tool.volume_m3=5e-6", "tin.refine_m=0.004", "erosion.rule=\"edge\""});
   auto t = make(s);
@@ -165,9 +165,7 @@ TEST(TinErosion, ConserveVolumeMakesRefiningErosionExact) {
 
 // Curvature refinement (tin.curvature_tolerance_m): creases that sand crosses are split down
 // to half of tin.refine_m, the flanks stay coarse; the pile comes out rounder than without it,
-// and as high as the ideal cone. (Before the cotangent split of common/erosion.hpp the coarse
-// TIN's poured pile was lobed, spread 0.092, top 16.7 mm; it is now round enough that the
-// refinement gains less.)
+// and as high as the ideal cone.
 TEST(TinErosion, CurvatureRefinementSplitsCreasesWhereSandFlows) {
   PileOutcome off, on;
   pour_pile({}, off);

@@ -67,8 +67,6 @@ TEST(TinSimplify, OnlyFlatVerticesAreRemoved) {
     const SimplifyReport r = t->simplify(SimplifyParams{0.4});
     SB_ASSERT_TIN_OK(*t);
     EXPECT_LE(r.removed, r.candidates);
-    EXPECT_GE(r.detect_s, 0.0);
-    EXPECT_GE(r.remove_s, 0.0);
     std::set<Key> after;
     for (const Vec3& v : t->mesh().vertices) after.insert({v.x(), v.y()});
     std::size_t gone = 0;

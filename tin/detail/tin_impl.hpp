@@ -125,13 +125,28 @@ struct CaptureResult {
 
 struct StampWork;  // stamp_work.hpp
 
+// What a TIN is built from: the scene's domain and [tin] section, and the few values of its
+// other sections the model needs (tin_options picks them from a Scene), nothing else (no
+// haptics, no output settings).
+struct TinOptions {
+  DomainSpec domain;
+  TinSpec tin;
+  int idle_passes = 1;                // [erosion] idle_passes
+  double settle_tolerance_deg = 0.0;  // [erosion] settle_tolerance_deg
+  Material material;
+  double tool_radius_m = 0.0;  // the tool's characteristic radius (tool_radius)
+  TerrainKind kind = TerrainKind::Flat;
+  double base_height_m = 0.0;  // [terrain] height_m
+};
+TinOptions tin_options(const Scene& scene);  // build.cpp
+
 // The edge length erosion refines to when tin.refine_m is 0: 4 tin.tolerance_m / tan(critical
 // angle), at most 5 % of the domain (build.cpp).
-double default_refine_m(const Scene& scene);
+double default_refine_m(const TinOptions& o);
 
 class TinTerrain final : public Terrain {
  public:
-  explicit TinTerrain(const Scene& scene);
+  explicit TinTerrain(const TinOptions& o);
   void build_from_field(const HeightField& field);  // build.cpp
   // build.cpp; with `field`, the heights then become its projection (project_heights).
   void build_from_points(const std::vector<Vec3>& points, const HeightField* field = nullptr);
