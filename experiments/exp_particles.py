@@ -205,30 +205,75 @@ def variants(default):
             [(f"{b} {other}", b, (f"tool.displacement={other}",)) for b in BACKENDS]), other
 
 
-def tool_force_table(ctx, refs, summaries):
-    """The particles' tool force while cutting (mean over the middle of the path), per case."""
+def cutting_window(t, x, y):
+    """Samples in the middle half of the tool's motion along the path, and the motion's direction."""
+    moving = np.hypot(np.gradient(x), np.gradient(y)) > 1e-9
+    if moving.sum() < 4:
+        return None, None
+    t0, t1 = t[moving].min(), t[moving].max()
+    mid = moving & (t > t0 + 0.25 * (t1 - t0)) & (t < t1 - 0.25 * (t1 - t0))
+    direction = np.array([x[moving][-1] - x[moving][0], y[moving][-1] - y[moving][0]])
+    return mid, direction / np.linalg.norm(direction)
+
+
+def mean_force(t, xy, f):
+    """Mean resistance against the motion and mean upward force while cutting."""
+    mid, direction = cutting_window(t, xy[:, 0], xy[:, 1])
+    if mid is None or not mid.any():
+        return math.nan, math.nan
+    return float(np.mean(-(f[mid, :2] @ direction))), float(np.mean(f[mid, 2]))
+
+
+def model_forces(ctx, ref):
+    """The haptic force model's force on the particles' own tool trajectory (seed 1's), replayed
+    through `sandbench interactive` on every back-end (the model's force at the device's pose, as
+    the session records it); {} without xvfb-run, and in the tiny profile (the replays run in real
+    time, and their forces follow the machine's timing)."""
+    import shutil
+    import exp_haptics
+    if shutil.which("xvfb-run") is None or not ref.forces or ctx.profile_name == "tiny":
+        return {}
+    f = ref.forces[sorted(ref.forces)[0]]
+    folder = ctx.runs / "particles" / f"{ref.case}-haptics"
+    folder.mkdir(parents=True, exist_ok=True)
+    trajectory = folder / "trajectory.csv"
+    step = 0.001
+    ts = np.arange(0.0, f[-1, 0], step)
+    rows = ["t,x,y,z,buttons"] + [f"{t:.6f},{np.interp(t, f[:, 0], f[:, 1]):.9g},{np.interp(t, f[:, 0], f[:, 2]):.9g},"
+                                  f"{np.interp(t, f[:, 0], f[:, 3]):.9g},0" for t in ts]
+    trajectory.write_text("\n".join(rows) + "\n")
+    what = ["particles haptics", trajectory, sbrun.ROOT / ref.scene, *BACKENDS]
+    reuse = ctx.is_current(folder, what)
+    out = {}
+    for b in BACKENDS:
+        _, rec = exp_haptics.replay(ctx.sandbench, b, folder, recording=trajectory, reuse=reuse,
+                                    scene=sbrun.ROOT / ref.scene)
+        model = rec["model"] if np.all(np.isfinite(rec["model"])) else rec["f"]
+        out[b] = mean_force(rec["t"], rec["xy"], model)
+    ctx.mark_current(folder, what)
+    return out
+
+
+def tool_force_table(ctx, refs):
+    """The tool's force while cutting: the particles' (mean ± sd over seeds) and the haptic force
+    model's on the same trajectory, per back-end."""
     rows = []
     for ref in refs:
         if not ref.forces:
             continue
-        means = []
-        for f in ref.forces.values():
-            t, x, y = f[:, 0], f[:, 1], f[:, 2]
-            moving = np.hypot(np.gradient(x), np.gradient(y)) > 0
-            if moving.sum() < 4:
-                continue
-            t0, t1 = t[moving].min(), t[moving].max()
-            mid = moving & (t > t0 + 0.25 * (t1 - t0)) & (t < t1 - 0.25 * (t1 - t0))
-            direction = np.array([x[moving][-1] - x[moving][0], y[moving][-1] - y[moving][0]])
-            direction /= np.linalg.norm(direction)
-            means.append((float(np.mean(-(f[mid, 4:6] @ direction))), float(np.mean(f[mid, 6]))))
-        if means:
-            m = np.array(means)
-            rows.append([ref.case, f"{m[:, 0].mean():.2f} ± {m[:, 0].std():.2f}",
-                         f"{m[:, 1].mean():.2f} ± {m[:, 1].std():.2f}"])
+        means = np.array([mean_force(f[:, 0], f[:, 1:3], f[:, 4:7]) for f in ref.forces.values()])
+        model = model_forces(ctx, ref)
+        row = [ref.case, f"{means[:, 0].mean():.2f} ± {means[:, 0].std():.2f}",
+               f"{means[:, 1].mean():.2f} ± {means[:, 1].std():.2f}"]
+        for b in BACKENDS:
+            row += [f"{model[b][0]:.2f}", f"{model[b][1]:.2f}"] if b in model else ["", ""]
+        rows.append(row)
     if not rows:
         return ""
-    return ctx.table("particles_tool_force", ["case", "resistance along the motion, N", "vertical (up), N"], rows)
+    headers = ["case", "particles: against the motion, N", "particles: up, N"]
+    for b in BACKENDS:
+        headers += [f"model on {b}: against the motion, N", f"model on {b}: up, N"]
+    return ctx.table("particles_tool_force", headers, rows)
 
 
 def run(ctx):
@@ -283,7 +328,7 @@ def run(ctx):
     figures = {"sections": section_figure(ctx, cases, names), "difference": difference_figure(ctx, cases),
                "speed": speed_figure(ctx, cases, names)}
     out = values(cases, md, figures, other)
-    out.update({"displacement": default, "compared": other, "tool_force": tool_force_table(ctx, refs, summaries)})
+    out.update({"displacement": default, "compared": other, "tool_force": tool_force_table(ctx, refs)})
     return out
 
 
