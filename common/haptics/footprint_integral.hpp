@@ -25,9 +25,10 @@ class FootprintCells {
   // Each half-plane clip at most doubles the vertex count; a piece takes four clips.
   static constexpr int kCapacity = 16 * kMaxVertices + 16;
 
-  // Calls f(piece, count, i, j) for every cell (i, j) with 0 <= i < cells_x, 0 <= j < cells_y
-  // that `poly` (n vertices, counter-clockwise, lattice coordinates) overlaps. Returns the
-  // number of cells visited.
+  // Calls f(piece, count, i, j, whole) for every cell (i, j) with 0 <= i < cells_x,
+  // 0 <= j < cells_y that `poly` (n vertices, counter-clockwise, lattice coordinates) overlaps;
+  // whole: the piece is the entire cell (its square, counter-clockwise). Returns the number of
+  // cells visited.
   template <class F>
   int for_each_piece(const Vec2* poly, int n, int cells_x, int cells_y, F&& f) {
     if (n < 3 || n > kMaxVertices) return 0;
@@ -102,7 +103,7 @@ class FootprintCells {
         int k = clip(strip_.data(), m, a_.data(), 0, c0, false);
         k = clip(a_.data(), k, piece_.data(), 0, c1, true);
         if (k >= 3) {
-          f(static_cast<const Vec2*>(piece_.data()), k, i, j);
+          f(static_cast<const Vec2*>(piece_.data()), k, i, j, false);
           ++visited;
         }
         continue;
@@ -114,7 +115,7 @@ class FootprintCells {
         square_[1] = Vec2(c1, lo);
         square_[2] = Vec2(c1, hi);
         square_[3] = Vec2(c0, hi);
-        f(static_cast<const Vec2*>(square_.data()), 4, i, j);
+        f(static_cast<const Vec2*>(square_.data()), 4, i, j, true);
         ++visited;
       }
     }

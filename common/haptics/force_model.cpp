@@ -21,13 +21,14 @@ struct CellIntegrand {
   double depth(const Vec2& q) const {
     const double a = q.x() - i, b = q.y() - j;
     const double h = (1.0 - b) * ((1.0 - a) * h00 + a * h10) + b * ((1.0 - a) * h01 + a * h11);
-    double bottom = tool_z;
-    if (params.profile == BottomProfile::SphereCap) {
-      const double R = params.sphere_radius_m;
-      const double dx = (q.x() - centre_u) * spacing, dy = (q.y() - centre_v) * spacing;
-      bottom += R - std::sqrt(std::max(0.0, R * R - dx * dx - dy * dy));
-    }
-    return h - bottom;
+    if (params.profile != BottomProfile::SphereCap) return h - tool_z;
+    const double du = q.x() - centre_u, dv = q.y() - centre_v;
+    return h - bottom(du * du + dv * dv);
+  }
+  // The sphere cap's height at squared distance r2 (lattice units) from the tool's centre.
+  double bottom(double r2) const {
+    const double R = params.sphere_radius_m;
+    return tool_z + R - std::sqrt(std::max(0.0, R * R - r2 * spacing * spacing));
   }
 };
 
@@ -97,19 +98,41 @@ ForceOutput compute_force(const HeightPatch& patch, const Vec3& position_m, cons
 
   CellIntegrand g{p, position_m.z(), (c.x() - h.origin_m.x()) * inv_s, (c.y() - h.origin_m.y()) * inv_s, h.spacing_m};
   Sums sums;
+  const bool flat = p.profile == BottomProfile::Flat;
+  // One cell's share of the integrals.
+  auto cell = [&](const Vec2* piece, int count, int i, int j, bool whole) {
+    const double* row = h.values.data() + static_cast<std::size_t>(j) * h.nx + i;
+    g.h00 = row[0];
+    g.h10 = row[1];
+    g.h01 = row[h.nx];
+    g.h11 = row[h.nx + 1];
+    const double hmax = std::max(std::max(g.h00, g.h10), std::max(g.h01, g.h11));
+    if (flat) {
+      // Under a flat bottom the depth is bilinear, extreme at the corners: a cell whose corners
+      // are all above the sand adds nothing; a whole cell whose corners are all deeper than
+      // kContactDepth_m has bilinear integrands, and the midpoint rule's value (exact for them)
+      // is the corners' mean, computed directly.
+      if (hmax <= g.tool_z) return;
+      const double lo = std::min(std::min(g.h00, g.h10), std::min(g.h01, g.h11)) - g.tool_z;
+      if (whole && lo >= kContactDepth_m) {
+        sums.displaced += 0.25 * (g.h00 + g.h10 + g.h01 + g.h11) - g.tool_z;
+        sums.contact += 1.0;
+        return;
+      }
+    } else {
+      // A sphere cap is lowest at the cell's point nearest the tool's centre: a cell whose
+      // sand stays above that adds nothing.
+      const double du = std::max(0.0, std::max(i - g.centre_u, g.centre_u - (i + 1.0)));
+      const double dv = std::max(0.0, std::max(j - g.centre_v, g.centre_v - (j + 1.0)));
+      if (hmax <= g.bottom(du * du + dv * dv)) return;
+    }
+    g.i = i;
+    g.j = j;
+    integrate_piece(g, piece, count, sums);
+  };
   thread_local FootprintCells<ForceParams::kMaxFootprint> cells;
-  out.footprint_cells = cells.for_each_piece(poly.data(), n, static_cast<int>(h.nx) - 1, static_cast<int>(h.ny) - 1,
-                                             [&](const Vec2* piece, int count, int i, int j) {
-                                               const double* row =
-                                                   h.values.data() + static_cast<std::size_t>(j) * h.nx + i;
-                                               g.h00 = row[0];
-                                               g.h10 = row[1];
-                                               g.h01 = row[h.nx];
-                                               g.h11 = row[h.nx + 1];
-                                               g.i = i;
-                                               g.j = j;
-                                               integrate_piece(g, piece, count, sums);
-                                             });
+  out.footprint_cells =
+      cells.for_each_piece(poly.data(), n, static_cast<int>(h.nx) - 1, static_cast<int>(h.ny) - 1, cell);
 
   const double cell_area = h.spacing_m * h.spacing_m;
   out.displaced_m3 = std::max(0.0, sums.displaced * cell_area);
