@@ -24,7 +24,7 @@
 namespace sb::haptics {
 
 inline constexpr double kFrictionVelocityEps = 0.005;  // m/s; below it friction fades linearly
-inline constexpr double kContactDepth_m = 0.002;       // a footprint point's drag engages over this depth
+inline constexpr double kContactDepth_m = 0.003;       // a footprint point's drag engages over this depth
 
 struct ForceOutput {
   Vec3 force_n{0.0, 0.0, 0.0};    // as the model asks, before the device's force limit
