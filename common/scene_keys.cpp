@@ -79,7 +79,7 @@ std::string scene_key_meaning(const std::string& key) {
       {"output.energy", "record the potential energy after each step"},
       {"reference.kind", "analytic reference for the accuracy metrics"},
       {"haptics.blend_ms", "interactive servo: a new height patch's force jump fades out over this time"},
-      {"haptics.max_force_rate_n_per_s", "interactive servo: force change limit per second; 0: unlimited"},
+      {"haptics.max_force_rate_n_per_s", "interactive servo: force change limit per second, a fault guard; 0: unlimited"},
       {"haptics.passivity_control", "passivity controller: damping whenever the observer would go positive"},
       {"haptics.passivity_max_force_n", "passivity controller: at most this damping force"},
       {"haptics.coupling", "virtual coupling: the sand pushes a simulated tool tied to the device"},

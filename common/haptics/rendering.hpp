@@ -8,9 +8,11 @@
 //   linearly over blend_s, so the surface the hand feels moves from the old patch to the new
 //   one continuously instead of in one tick (the tool's own stamp then feels like sand giving
 //   way, not like a click).
-// - Force-rate limit: no tick changes the commanded force by more than
-//   max_force_rate_n_per_s / servo rate (a real collision onset included). Losing the pose
-//   still drops the force to zero at once.
+// - Force-rate limit, a fault guard: no tick changes the commanded force by more than
+//   max_force_rate_n_per_s / servo rate. The force model is continuous in the tool's pose
+//   (force_model.hpp) and the blend covers patch swaps, so on smooth motion the limit never
+//   acts; it only catches what a fault would send (a corrupt patch, a pose jump). Losing the
+//   pose still drops the force to zero at once.
 // - Passivity (Hannaford and Ryu 2002): an observer sums the energy the device delivered to the
 //   hand; a controller adds just enough damping (at most passivity_max_force_n) whenever the
 //   next tick would make that sum positive.
@@ -21,7 +23,7 @@ namespace sb::haptics {
 
 struct RenderingOptions {
   double blend_s = 0.05;                       // haptics.blend_ms; 0: patches switch at once
-  double max_force_rate_n_per_s = 80.0;        // haptics.max_force_rate_n_per_s; 0: unlimited
+  double max_force_rate_n_per_s = 2000.0;      // haptics.max_force_rate_n_per_s; 0: unlimited
   bool passivity = true;                       // haptics.passivity_control
   double passivity_max_force_n = 1.0;          // haptics.passivity_max_force_n
   bool coupling = false;                       // haptics.coupling

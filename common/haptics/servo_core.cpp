@@ -94,6 +94,7 @@ Vec3 ServoCore::render(ServoState& s, double dt) {
   }
   s.blend_offset_n = blend_.offset();
   const Vec3 sand = s.model.force_n + blend_.offset();
+  s.model_force_n = sand;
   blend_.advance(fade_dt);
   if (!sand.allFinite()) {  // sent as zero (and counted) by limit_force
     blend_.reset();

@@ -26,6 +26,10 @@ struct ServoState {
   Vec3 velocity_m_s{0.0, 0.0, 0.0};
   Vec3 force_n{0.0, 0.0, 0.0};  // as commanded
   ForceOutput model;            // the model's view (its force before rendering and limiting)
+  // The model's force at this pose on the patches the servo holds, the blend's offset
+  // included: what would be sent without coupling, rate limit, passivity control and the
+  // device's force limit. The force sent is judged against it.
+  Vec3 model_force_n{0.0, 0.0, 0.0};
   bool clamped = false;
   bool nonfinite = false;  // the model's force was not finite; zero was sent
   std::uint64_t patch_version = 0;

@@ -13,7 +13,8 @@ using std::chrono::nanoseconds;
 ServoLoop::ServoLoop(HapticDevice& device, PatchBuffer& patches, const ServoOptions& options)
     : core_(device, patches, options.velocity_cutoff_hz, options.rendering, 1.0 / options.rate_hz),
       options_(options),
-      samples_(options.record_capacity) {}
+      samples_(options.record_capacity),
+      onset_lag_(1.0 / options.rate_hz) {}
 
 ServoLoop::~ServoLoop() { stop(); }
 
@@ -41,12 +42,24 @@ ServoStats ServoLoop::stats() const {
   s.force_step_n_p99 = force_step_n_.percentile(0.99);
   s.force_step_n_p999 = force_step_n_.percentile(0.999);
   s.force_step_n_max = force_step_n_.max();
+  s.force_error_n_p50 = force_error_n_.percentile(0.5);
+  s.force_error_n_p99 = force_error_n_.percentile(0.99);
+  s.force_error_n_max = force_error_n_.max();
+  s.force_error_unblended_n_p50 = force_error_unblended_n_.percentile(0.5);
+  s.force_error_unblended_n_p99 = force_error_unblended_n_.percentile(0.99);
+  s.force_error_unblended_n_max = force_error_unblended_n_.max();
+  s.onsets = onset_lag_.onsets();
+  s.onset_lag_ms_max = 1e3 * onset_lag_.lag_max_s();
+  s.onset_held_force_n = onset_lag_.held_force_n();
   return s;
 }
 
 void ServoLoop::run() {
   stats_ = ServoStats{};
   force_step_n_ = TickHistogram(0.001, 20.0);
+  force_error_n_ = TickHistogram(0.001, 20.0);
+  force_error_unblended_n_ = TickHistogram(0.001, 20.0);
+  onset_lag_ = OnsetLag(1.0 / options_.rate_hz);
   stats_.realtime = options_.realtime && request_realtime();
   const auto period = std::chrono::duration_cast<nanoseconds>(duration<double>(1.0 / options_.rate_hz));
   const auto spin = std::chrono::duration_cast<nanoseconds>(duration<double, std::micro>(options_.spin_us));
@@ -71,6 +84,7 @@ void ServoLoop::run() {
       r.valid = s.device.valid;
       r.force_n = s.force_n;
       r.penetration_m = s.model.penetration_m;
+      r.model_force_n = s.model_force_n;
       if (!samples_.push(r)) ++stats_.samples_dropped;
     }
 
@@ -86,6 +100,13 @@ void ServoLoop::run() {
     stats_.ticks_without_pose += !s.device.valid;
     stats_.ticks_outside_patch += s.model.outside_patch;
     force_step_n_.add(s.force_step_n);
+    if (s.device.valid) {
+      const double limit = core_.limits().max_force_n;
+      const Vec3 model = limit_force(s.model_force_n, limit).force_n;
+      force_error_n_.add((s.force_n - model).norm());
+      force_error_unblended_n_.add((s.force_n - limit_force(s.model.force_n, limit).force_n).norm());
+      onset_lag_.add(model.norm(), s.force_n.norm());
+    }
     stats_.patch_switches += s.patch_switched;
     stats_.ticks_rate_limited += s.rate_limited;
     late_us_.add(duration<double, std::micro>(start - deadline).count());
@@ -117,6 +138,7 @@ void ServoLoop::run() {
       deadline += skipped * period;
     }
   }
+  onset_lag_.finish();
   stats_.duration_s = duration<double>(last_start - first_start).count();
   const PassivityController& pc = core_.passivity();
   stats_.passivity_energy_j = pc.energy_j();

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <thread>
 
+#include "common/haptics/onset_lag.hpp"
 #include "common/haptics/servo_core.hpp"
 #include "common/haptics/spsc_ring.hpp"
 #include "common/haptics/tick_histogram.hpp"
@@ -34,6 +35,7 @@ struct ServoSample {
   bool valid = false;
   Vec3 force_n{0.0, 0.0, 0.0};
   double penetration_m = 0.0;
+  Vec3 model_force_n{0.0, 0.0, 0.0};  // ServoState::model_force_n
 };
 
 // The haptic statistics of README "Interactive mode and haptics" (servo_hz, tick_us.*, missed_deadlines, force_max_n)
@@ -54,6 +56,16 @@ struct ServoStats {
   // Continuity: |force(n) - force(n-1)| over all ticks (1 mN bins), and what shaped it.
   double force_step_n_p99 = 0.0, force_step_n_p999 = 0.0, force_step_n_max = 0.0;
   std::uint64_t patch_switches = 0, ticks_rate_limited = 0;
+  // Fidelity: |force sent - the model's force at the same pose| over the ticks with a pose
+  // (1 mN bins), against the model with the patch blend (ServoState::model_force_n) and
+  // without it (the model on the newest patch alone); both model forces are first passed
+  // through the device's force limit, which no rendering can exceed.
+  double force_error_n_p50 = 0.0, force_error_n_p99 = 0.0, force_error_n_max = 0.0;
+  double force_error_unblended_n_p50 = 0.0, force_error_unblended_n_p99 = 0.0, force_error_unblended_n_max = 0.0;
+  // Contact onsets (onset_lag.hpp): how many, the largest lag of the force sent behind the
+  // model's in reaching 90 % of the held force, and the last onset's held force.
+  std::uint64_t onsets = 0;
+  double onset_lag_ms_max = 0.0, onset_held_force_n = 0.0;
   // Passivity (passivity.hpp): the observer's energy at the end and at most (J, > 0: energy
   // was created), the damping the controller added.
   double passivity_energy_j = 0.0, passivity_energy_max_j = 0.0, passivity_dissipated_j = 0.0;
@@ -95,6 +107,8 @@ class ServoLoop {
   // Servo thread only until joined.
   TickHistogram tick_us_, late_us_;
   TickHistogram force_step_n_{0.001, 20.0};
+  TickHistogram force_error_n_{0.001, 20.0}, force_error_unblended_n_{0.001, 20.0};
+  OnsetLag onset_lag_;
   ServoStats stats_;
 };
 

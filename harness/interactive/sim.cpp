@@ -270,7 +270,7 @@ void Simulation::drain_samples() {
   while (servo_.samples().pop(r)) {
     if (!recording_ || !r.valid) continue;
     session_.trajectory.samples.push_back({r.t_s, r.position_m, r.buttons});
-    session_.forces.push_back({r.t_s, r.force_n, r.penetration_m});
+    session_.forces.push_back({r.t_s, r.force_n, r.penetration_m, r.model_force_n});
   }
 }
 

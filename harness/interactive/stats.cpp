@@ -39,6 +39,16 @@ Json haptic_stats_json(const haptics::ServoStats& s, const haptics::DeviceLimits
   j["force_step_n.max"] = s.force_step_n_max;
   j["patch_switches"] = s.patch_switches;
   j["ticks_rate_limited"] = s.ticks_rate_limited;
+  // Fidelity: the force sent against the model's force at the same pose (servo_loop.hpp).
+  j["force_error_n.p50"] = s.force_error_n_p50;
+  j["force_error_n.p99"] = s.force_error_n_p99;
+  j["force_error_n.max"] = s.force_error_n_max;
+  j["force_error_unblended_n.p50"] = s.force_error_unblended_n_p50;
+  j["force_error_unblended_n.p99"] = s.force_error_unblended_n_p99;
+  j["force_error_unblended_n.max"] = s.force_error_unblended_n_max;
+  j["onsets"] = s.onsets;
+  j["onset_lag_ms.max"] = s.onset_lag_ms_max;
+  j["onset_held_force_n"] = s.onset_held_force_n;
   j["passivity.energy_j"] = s.passivity_energy_j;
   j["passivity.energy_max_j"] = s.passivity_energy_max_j;
   j["passivity.dissipated_j"] = s.passivity_dissipated_j;

@@ -21,7 +21,9 @@ using haptics::csv_number;
 using haptics::CsvFile;
 using haptics::CsvTable;
 
-const std::vector<std::string> kForceHeader{"t", "fx", "fy", "fz", "penetration_m"};
+const std::vector<std::string> kForceHeader{"t", "fx", "fy", "fz", "penetration_m", "model_fx", "model_fy", "model_fz"};
+// Sessions written before the model's force was recorded.
+const std::vector<std::string> kForceHeaderWithoutModel{"t", "fx", "fy", "fz", "penetration_m"};
 const std::vector<std::string> kToolHeader{
     "tool",    "shape",       "radius_m",         "size_x_m",       "size_y_m", "sides", "profile", "sphere_radius_m",
     "depth_m", "rim_width_m", "rim_forward_bias", "pour_volume_m3", "polygon_m"};
@@ -106,7 +108,9 @@ void write_session(const std::filesystem::path& file, const Session& s) {
       out << join(kForceHeader) << "\n";
       for (const SessionForce& f : s.forces)
         out << exact_number(f.t_s) << "," << exact_number(f.force_n.x()) << "," << exact_number(f.force_n.y()) << ","
-            << exact_number(f.force_n.z()) << "," << exact_number(f.penetration_m) << "\n";
+            << exact_number(f.force_n.z()) << "," << exact_number(f.penetration_m) << ","
+            << exact_number(f.model_force_n.x()) << "," << exact_number(f.model_force_n.y()) << ","
+            << exact_number(f.model_force_n.z()) << "\n";
     }
     out << join(kToolHeader) << "\n";
     for (std::size_t i = 0; i < s.tools.size(); ++i) out << i << "," << tool_fields(s.tools[i]) << "\n";
@@ -155,7 +159,14 @@ Session read_session(const std::filesystem::path& file, const std::string& optio
       for (std::size_t r = 0; r < t->rows.size(); ++r)
         s.forces.push_back({csv_number(f, *t, r, 0),
                             {csv_number(f, *t, r, 1), csv_number(f, *t, r, 2), csv_number(f, *t, r, 3)},
-                            csv_number(f, *t, r, 4)});
+                            csv_number(f, *t, r, 4),
+                            {csv_number(f, *t, r, 5), csv_number(f, *t, r, 6), csv_number(f, *t, r, 7)}});
+    } else if (const CsvTable* old = f.find(kForceHeaderWithoutModel)) {
+      for (std::size_t r = 0; r < old->rows.size(); ++r)
+        s.forces.push_back({csv_number(f, *old, r, 0),
+                            {csv_number(f, *old, r, 1), csv_number(f, *old, r, 2), csv_number(f, *old, r, 3)},
+                            csv_number(f, *old, r, 4),
+                            {0.0, 0.0, 0.0}});
     }
     const CsvTable* tools = f.find(kToolHeader);
     const CsvTable* stamps = f.find(kStampHeader);

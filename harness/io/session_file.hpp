@@ -5,7 +5,9 @@
 //   # sandbench session 1 / # scene: ... / # backend: ... / # set key=value (scene overrides
 //     the session made, e.g. material sliders; replay applies them before its own --set)
 //   t,x,y,z,buttons                 the device trajectory (README: the replay format)
-//   t,fx,fy,fz,penetration_m        the force sent at each of those ticks
+//   t,fx,fy,fz,penetration_m,model_fx,model_fy,model_fz   the force sent at each of those ticks
+//     and the model's force at the same pose (ServoState::model_force_n); files without the
+//     model's columns still read (model force 0)
 //   tool,shape,radius_m,...         every tool used, in full
 //   stamp,t,x,y,bottom_z,heading_rad,dir_x,dir_y,tool   every stamp applied, in order
 // Numbers are written with round-trip precision, so replayed stamps are the recorded ones
@@ -33,6 +35,7 @@ struct SessionForce {
   double t_s = 0.0;
   Vec3 force_n{0.0, 0.0, 0.0};
   double penetration_m = 0.0;
+  Vec3 model_force_n{0.0, 0.0, 0.0};  // the model's force at the same pose, blend included
 };
 
 struct Session {

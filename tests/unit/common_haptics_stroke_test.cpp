@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "common/erosion.hpp"
+#include "common/haptics/onset_lag.hpp"
 #include "common/haptics/replay_device.hpp"
 #include "common/haptics/servo_core.hpp"
 #include "common/metrics.hpp"
@@ -25,7 +26,10 @@ constexpr double kDt = 0.001;
 constexpr int kSimEvery = 5;  // ticks per simulation step
 
 struct StrokeRun {
-  std::vector<double> steps_n, steady_n;  // per-tick change; |F| in steady contact
+  std::vector<double> steps_n, steady_n;   // per-tick change; |F| in steady contact
+  std::vector<double> error_n;             // |force sent - the model's force at the same pose|
+  double onset_lag_s = 0.0, held_n = 0.0;  // onset_lag.hpp: the largest lag, the last held force
+  std::uint64_t onsets = 0;
   double force_max_n = 0.0, energy_j = 0.0;
   bool finite = true;
   std::uint64_t stamps = 0;
@@ -59,6 +63,7 @@ StrokeRun replay_stroke(const PreparedScene& prepared, const Trajectory& stroke,
   core.start();
 
   StrokeRun r;
+  OnsetLag onset(kDt);
   bool have_stamp = false;
   Vec2 last_xy(0, 0);
   double last_z = 0.0;
@@ -73,6 +78,9 @@ StrokeRun replay_stroke(const PreparedScene& prepared, const Trajectory& stroke,
     r.force_max_n = std::max(r.force_max_n, s.force_n.norm());
     r.steps_n.push_back((s.force_n - last_force).norm());
     last_force = s.force_n;
+    const Vec3 model = limit_force(s.model_force_n, lim.max_force_n).force_n;
+    r.error_n.push_back((s.force_n - model).norm());
+    onset.add(model.norm(), s.force_n.norm());
     const Vec3 p = s.device.position_m;
     if (p.z() <= bottom + 1e-4 && s.velocity_m_s.head<2>().norm() > 0.01) r.steady_n.push_back(s.force_n.norm());
     if (i % kSimEvery != kSimEvery - 1) continue;
@@ -99,7 +107,83 @@ StrokeRun replay_stroke(const PreparedScene& prepared, const Trajectory& stroke,
     if (changed || (xy - patch_centre).norm() > (layout.half_m - params.reach_m) / 3.0) republish(xy);
   }
   r.energy_j = core.passivity().energy_j();
+  onset.finish();
+  r.onset_lag_s = onset.lag_max_s();
+  r.onsets = onset.onsets();
+  r.held_n = onset.held_force_n();
   return r;
+}
+
+// A smooth motion as experiments/haptics_trajectory.py writes it: 0.2 s above the sand, a
+// minimum-jerk plunge from 3 mm above to 10 mm into it, a hold of 0.4 s, a minimum-jerk stroke
+// of 0.1 m at `heading`, a hold, the lift, 0.2 s above. Sampled every millisecond.
+Trajectory smooth_motion(double heading_rad, double stroke_s, double plunge_s) {
+  auto blend = [](double s) {
+    s = std::clamp(s, 0.0, 1.0);
+    return s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
+  };
+  const Vec2 centre(0.35355339, 0.35355339), dir(std::cos(heading_rad), std::sin(heading_rad));
+  const Vec2 start = centre - 0.05 * dir;
+  const double top = 0.103, bottom = 0.09, hold = 0.4;
+  const double t_plunge = 0.2, t_stroke = t_plunge + plunge_s + hold, t_lift = t_stroke + stroke_s + hold;
+  const double end = t_lift + plunge_s + 0.2;
+  Trajectory t;
+  for (int i = 0; i * 0.001 <= end; ++i) {
+    const double at = i * 0.001;
+    const double down = blend((at - t_plunge) / plunge_s) - blend((at - t_lift) / plunge_s);
+    const Vec2 xy = start + 0.1 * blend((at - t_stroke) / stroke_s) * dir;
+    t.samples.push_back({at, Vec3(xy.x(), xy.y(), top + (bottom - top) * down), 0});
+  }
+  return t;
+}
+
+TEST(HapticsStroke, SmoothMotionsAreRenderedAsTheModelComputesThemOnEveryBackend) {
+  // Plunges peaking at 0.2 m/s (13 mm in 0.122 s) and slower, strokes at three headings and
+  // speeds, a disk, a box and a sphere-capped disk: with the shipped settings the force sent
+  // is the continuous model's (the rate limit, a fault guard, never acts; the blend covers the
+  // patch swaps), with no lag at contact onset, and continuous from tick to tick.
+  PreparedScene prepared = prepare_scene(load_scene(SB_SOURCE_DIR "/experiments/scenes/flat_stroke.toml"));
+  const ToolSpec disk = prepared.scene.tool;
+  ToolSpec box = disk, sphere = disk;
+  box.shape = ToolShape::Box;
+  box.half_size_m = Vec2(0.02, 0.01);
+  sphere.profile = BottomProfile::SphereCap;
+  sphere.sphere_radius_m = 0.05;
+  struct Motion {
+    const char* name;
+    ToolSpec tool;
+    double heading_rad, stroke_s, plunge_s;
+  };
+  const Motion motions[] = {{"disk 45deg 1.5 s", disk, 0.785398, 1.5, 0.122},
+                            {"box 0deg 0.8 s", box, 0.0, 0.8, 0.122},
+                            {"sphere 120deg 2.5 s", sphere, 2.0944, 2.5, 0.3}};
+  RenderingOptions unlimited = prepared.scene.haptics;
+  unlimited.max_force_rate_n_per_s = 0.0;
+  for (const std::string& backend : backend_names()) {
+    for (const Motion& m : motions) {
+      SCOPED_TRACE(backend + ", " + m.name);
+      prepared.scene.tool = m.tool;
+      const Trajectory motion = smooth_motion(m.heading_rad, m.stroke_s, m.plunge_s);
+      for (const RenderingOptions& rendering : {prepared.scene.haptics, unlimited}) {
+        const StrokeRun r = replay_stroke(prepared, motion, backend, rendering);
+        const double step_max = *std::max_element(r.steps_n.begin(), r.steps_n.end());
+        const double step_p999 = percentile(r.steps_n, 0.999);
+        const double error_p99 = percentile(r.error_n, 0.99);
+        std::printf(
+            "%s, %s, rate limit %g N/s: step max %.3f N, p99.9 %.3f N; sent - model p99 %.3f N, max %.3f N; "
+            "%llu onsets, lag %.1f ms, held %.2f N\n",
+            backend.c_str(), m.name, rendering.max_force_rate_n_per_s, step_max, step_p999, error_p99,
+            *std::max_element(r.error_n.begin(), r.error_n.end()), static_cast<unsigned long long>(r.onsets),
+            1e3 * r.onset_lag_s, r.held_n);
+        EXPECT_TRUE(r.finite);
+        EXPECT_LE(step_max, 0.3);
+        EXPECT_LE(error_p99, 0.2);
+        EXPECT_EQ(r.onsets, 1u);
+        EXPECT_LE(r.onset_lag_s, 0.003);
+        EXPECT_LE(r.energy_j, 1e-9);
+      }
+    }
+  }
 }
 
 TEST(HapticsStroke, ReplayedStrokeIsContinuousPassiveAndStillPushesBackOnEveryBackend) {
