@@ -348,11 +348,10 @@ def values(cases, table, figures, other):
                          "dilation_pct": 100 * c["dilation"][0], "dilation_sd_pct": 100 * c["dilation"][1],
                          "speedup_min": min(speedup), "speedup_max": max(speedup),
                          "other_rmse_mm": {b: c["backends"][f"{b} {other}"]["section_rmse_m"] * 1e3 for b in BACKENDS},
-                         "verdict": ("the shared model: the back-ends agree with each other far better than with the "
-                                     "grains, so the distance is the tool model's, not a discretisation's"
-                                     if shared else
-                                     "the discretisation matters here: the back-ends differ from each other by a "
-                                     "sizeable part of their distance from the grains")})
+                         "verdict": ("the shared tool model, not a discretisation: the back-ends agree with each "
+                                     "other far better than with the grains" if shared else
+                                     "partly the discretisation: the back-ends differ from each other by a sizeable "
+                                     "part of their distance from the grains")})
             for b in BACKENDS:
                 summary.setdefault(b, {})["accuracy vs particle sand"] = \
                     f"{c['case']}: {rmse[b] * 1e3:.1f} mm section RMSE"
