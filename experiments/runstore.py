@@ -202,6 +202,18 @@ def execute(spec):
     return side
 
 
+def wait_child(proc):
+    """Waits for PROC, a child that stop_children() may kill meanwhile; (exit code, resource usage)."""
+    with _children_lock:
+        _children.add(proc)
+    try:
+        _, status, usage = os.wait4(proc.pid, 0)
+    finally:
+        with _children_lock:
+            _children.discard(proc)
+    return os.waitstatus_to_exitcode(status), usage
+
+
 def stop_children():
     """Kills every run in flight (the driver is being stopped)."""
     with _children_lock:

@@ -23,7 +23,6 @@ import shutil
 import signal
 import subprocess
 import sys
-import threading
 import time
 import tomllib
 from pathlib import Path
@@ -35,11 +34,11 @@ ROOT = HERE.parent.parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent))
 import lammps_input  # noqa: E402
+import runstore  # noqa: E402
 import surface  # noqa: E402
 
 SIDECAR = "done.json"
-_children = set()
-_children_lock = threading.Lock()
+stop_children = runstore.stop_children  # the children in flight are runstore's, whoever started them
 
 
 def load_toml(path):
@@ -94,32 +93,17 @@ def read_sidecar(spec):
     return side if side.get("key") == spec["key"] else None
 
 
-def stop_children():
-    with _children_lock:
-        for p in list(_children):
-            try:
-                p.kill()
-            except OSError:
-                pass
-
-
 def _lammps(spec, folder, input_name, text):
     (folder / input_name).write_text(text)
     log = input_name.replace(".in", ".log")
     cmd = lmp_command(spec["lmp"], spec["ranks"]) + ["-in", input_name, "-log", log, "-screen", "none", "-nocite"]
     env = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMP_NUM_THREADS="1")
     start = time.monotonic()
-    proc = subprocess.Popen(cmd, cwd=folder, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    with _children_lock:
-        _children.add(proc)
-    try:
-        _, status, usage = os.wait4(proc.pid, 0)
-    finally:
-        with _children_lock:
-            _children.discard(proc)
-    code = os.waitstatus_to_exitcode(status)
+    with open(folder / input_name.replace(".in", ".stderr"), "w") as err:
+        proc = subprocess.Popen(cmd, cwd=folder, env=env, stdout=subprocess.DEVNULL, stderr=err)
+        code, usage = runstore.wait_child(proc)
     if code != 0:
-        tail = (folder / log).read_text()[-2000:] if (folder / log).exists() else proc.stderr.read()[-2000:]
+        tail = (folder / log).read_text()[-2000:] if (folder / log).exists() else ""
         raise RuntimeError(f"lmp failed ({code}) on {folder / input_name}:\n{tail}")
     return {"wall_s": round(time.monotonic() - start, 2), "cpu_s": round(usage.ru_utime + usage.ru_stime, 2)}
 
