@@ -104,7 +104,11 @@ class Fields {
     note(key, "choice", "\"" + fallback + "\"", list);
     if (!n) return fallback;
     if (!n->is_string()) fail(key, "= " + describe(*n) + " must be one of " + list);
-    return *n->value<std::string>();
+    const std::string v = *n->value<std::string>();
+    for (const auto& a : allowed)
+      if (a == v) return v;
+    fail(key, "= \"" + v + "\" is not allowed; must be one of " + list);
+    return v;
   }
 
   std::string string(const std::string& key, bool required) {

@@ -6,9 +6,55 @@
 #include <numbers>
 #include <sstream>
 
+#include "common/raster.hpp"
+
 namespace sb::scene_detail {
 
 namespace {
+
+// The key that sets the tool's size.
+std::string tool_size_key(const ToolSpec& t) {
+  return t.shape == ToolShape::Polygon                              ? "tool.polygon_m"
+         : t.shape == ToolShape::Disk || t.shape == ToolShape::Pour ? "tool.radius_m"
+                                                                    : "tool.size_m";
+}
+
+// How far from its pose the tool's footprint reaches (a pour: its radius), plus its rim band
+// when `rim`.
+double tool_reach(const ToolSpec& t, bool rim) {
+  if (t.shape == ToolShape::Pour) return t.radius_m;
+  double r = 0.0;
+  for (const Vec2& p : t.footprint_local()) r = std::max(r, p.norm());
+  return rim ? r + t.rim.width_m : r;
+}
+
+// Refuses a tool that cannot fit in the domain at the points where the scene's reference
+// measures its work: the pour point (pile), the stamp with its rim band (crater), the middle
+// half of the stroke (trench, ridge).
+void check_reference_fit(const Scene& s) {
+  const auto& path = s.stroke.path_m;
+  std::vector<Vec2> at;
+  bool rim = false;
+  if (s.reference == ReferenceKind::Pile) at = {path.front()};
+  if (s.reference == ReferenceKind::Crater) {
+    at = {path.front()};
+    rim = true;
+  }
+  if (s.reference == ReferenceKind::Trench || s.reference == ReferenceKind::Ridge)
+    at = {path.front() + 0.25 * (path.back() - path.front()), path.front() + 0.75 * (path.back() - path.front())};
+  const double reach = tool_reach(s.tool, rim);
+  const Aabb2 box = s.domain.box();
+  for (const Vec2& c : at) {
+    if (c.x() - reach >= box.lo.x() && c.x() + reach <= box.hi.x() && c.y() - reach >= box.lo.y() &&
+        c.y() + reach <= box.hi.y())
+      continue;
+    std::ostringstream msg;
+    msg << "gives a tool reaching " << reach << " m from its pose" << (rim ? " (with tool.rim_width_m)" : "")
+        << ", which does not fit in the domain at (" << c.x() << ", " << c.y() << "), where reference.kind = \""
+        << to_string(s.reference) << "\" measures it; use a smaller tool or move stroke.path_m";
+    Fields::fail(tool_size_key(s.tool), msg.str());
+  }
+}
 
 // The larger side of the domain: ranges of lengths scale with it.
 double domain_extent(const Scene& s) { return std::max(s.domain.size_m.x(), s.domain.size_m.y()); }
@@ -16,7 +62,7 @@ double domain_extent(const Scene& s) { return std::max(s.domain.size_m.x(), s.do
 // [domain]
 void read_domain(Fields& f, Scene& s) {
   s.domain.origin_m = f.vec2("domain.origin_m", {0.0, 0.0}, open(-1e9, 1e9));
-  s.domain.size_m = f.vec2("domain.size_m", {}, positive(1e6), /*required=*/true);
+  s.domain.size_m = f.vec2("domain.size_m", Vec2(0.0, 0.0), positive(1e6), /*required=*/true);
   s.crs = f.string("domain.crs", /*required=*/false);
 }
 
@@ -113,9 +159,7 @@ void read_tool(Fields& f, Scene& s) {
     for (std::size_t i = 0; i < fp.size(); ++i) shortest = std::min(shortest, (fp[(i + 1) % fp.size()] - fp[i]).norm());
     const double least = 1e-9 * extent;
     if (!(shortest >= least)) {
-      const std::string key = t.shape == ToolShape::Polygon ? "tool.polygon_m"
-                              : t.shape == ToolShape::Disk  ? "tool.radius_m"
-                                                            : "tool.size_m";
+      const std::string key = tool_size_key(t);
       std::ostringstream msg;
       msg << "gives footprint edges of " << shortest << " m, shorter than 1e-9 x the domain extent (" << least
           << " m); use a larger tool"
@@ -204,14 +248,24 @@ void read_reference(Fields& f, Scene& s) {
     Fields::fail("reference.kind", "= \"ridge\" needs tool.shape = \"pour\" and a straight stroke.path_m of 2 points");
   if (s.reference == ReferenceKind::Plane && s.terrain.kind != TerrainKind::Plane)
     Fields::fail("reference.kind", "= \"plane\" needs terrain.kind = \"plane\"");
+  check_reference_fit(s);
 }
 
 // [output]
 void read_output(Fields& f, Scene& s) {
   const double extent = domain_extent(s);
-  s.output.raster_m = f.number("output.raster_m", std::min(0.0025, extent / 100.0), positive(extent));
+  // At least 2 samples across the smaller side, by default too.
+  const double smaller = s.domain.size_m.minCoeff();
+  s.output.raster_m = f.number("output.raster_m", std::min({0.0025, extent / 100.0, smaller}), positive(extent));
   const double samples = (s.domain.size_m.x() / s.output.raster_m + 1) * (s.domain.size_m.y() / s.output.raster_m + 1);
-  if (samples > 1e8) Fields::fail("output.raster_m", "gives more than 1e8 raster samples for this domain");
+  if (s.output.raster_m > smaller) {
+    std::ostringstream msg;
+    msg << "= " << s.output.raster_m << " gives fewer than 2 raster samples across the domain's smaller side ("
+        << smaller << " m); it must be at most that";
+    Fields::fail("output.raster_m", msg.str());
+  }
+  if (samples > kMaxRasterSamples)
+    Fields::fail("output.raster_m", "gives more than 1e8 raster samples for this domain");
   s.output.energy = f.boolean("output.energy", false);
 }
 

@@ -28,6 +28,7 @@ struct CompareOptions {
   std::vector<std::string> overrides;
   std::vector<std::string> unset;
   std::string replay;  // a recorded session replayed on every back-end
+  std::optional<std::uint64_t> max_memory;
 };
 
 std::vector<std::string> split(const std::string& s, char sep) {
@@ -88,7 +89,7 @@ void compare_command(const CompareOptions& o) {
   const std::filesystem::path dir = o.out;
   if (!dir.empty()) check_output_directory(dir, "--out", {o.scene, o.replay});  // --out '' fails its validator
 
-  PreparedScene prepared = prepare_input(o.scene, o.unset, o.overrides, o.replay);
+  PreparedScene prepared = prepare_input({o.scene, o.unset, o.overrides, o.replay, o.max_memory}, variants);
   // A folder being written holds this marker until its last picture is there, so a killed
   // compare leaves a folder that says it is incomplete.
   const std::filesystem::path marker = dir / "INCOMPLETE";
@@ -155,6 +156,7 @@ void add_compare_command(CLI::App& app) {
   cmd->add_option("--unset", opts->unset, "Remove a scene key (before --set): --unset tool.radius_m")->take_all();
   cmd->add_flag("--json", opts->json, "Print the report as JSON on stdout");
   cmd->add_option("--set", opts->overrides, "Override a scene key: --set tool.radius_m=0.03")->take_all();
+  add_max_memory_option(*cmd, opts->max_memory);
   cmd->callback([opts] { compare_command(*opts); });
 }
 

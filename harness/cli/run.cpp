@@ -22,11 +22,12 @@ struct RunOptions {
   std::vector<std::string> overrides;
   std::vector<std::string> unset;
   std::string replay;  // a recorded session whose stamps replace the scene's stroke
+  std::optional<std::uint64_t> max_memory;
 };
 
 void run_command(const RunOptions& o) {
-  PreparedScene prepared = prepare_input(o.scene, o.unset, o.overrides, o.replay);
   const Variant variant = parse_variant(o.backend, "--backend");
+  PreparedScene prepared = prepare_input({o.scene, o.unset, o.overrides, o.replay, o.max_memory}, {variant});
   const std::filesystem::path out =
       o.out.empty() ? default_run_path(o.scene, variant.label) : std::filesystem::path(o.out);
   check_output_path(out, "--out", {o.scene, o.replay});  // the default name too; --out '' fails its validator
@@ -53,6 +54,7 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--unset", opts->unset, "Remove a scene key (before --set): --unset tool.radius_m")->take_all();
   cmd->add_option("--replay", opts->replay,
                   "Replay a session recorded by `sandbench interactive --record`: its stamps are the schedule");
+  add_max_memory_option(*cmd, opts->max_memory);
   cmd->callback([opts] { run_command(*opts); });
 }
 

@@ -27,6 +27,11 @@ struct PreparedScene {
   StampSchedule schedule;
   ErosionRule rule;
   Raster raster_template;  // the common sampling lattice (values zero)
+  // How many vertices the model may add to its initial count before the run stops with an
+  // InputError (0: no bound); what set the bound, named in that message.
+  std::size_t max_added_vertices = 0;
+  bool replay = false;  // the schedule is a recorded session's, not the scene's stroke
+  std::string vertex_bound_reason;
 };
 PreparedScene prepare_scene(Scene scene);
 
