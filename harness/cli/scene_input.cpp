@@ -29,9 +29,11 @@ PreparedScene prepare_input(const SceneInput& in, const std::vector<Variant>& va
   // Before anything is allocated: refuse what cannot fit, warn of what is large.
   std::vector<PlannedRun> runs;
   for (const Variant& v : variants) runs.push_back({v.backend, variant_scene(v, scene)});
-  preflight(estimate_resources(runs, replay ? session.stamps.size() : stroke_stamps(scene), replay), in.max_memory);
+  const std::uint64_t limit =
+      preflight(estimate_resources(runs, replay ? session.stamps.size() : stroke_stamps(scene), replay), in.max_memory);
 
   PreparedScene prepared = prepare_scene(std::move(scene));
+  prepared.memory_limit_bytes = limit;
   if (replay) {
     prepared.schedule = session_schedule(session);
     prepared.scene.reference = ReferenceKind::None;

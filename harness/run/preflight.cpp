@@ -164,9 +164,10 @@ ResourceEstimate estimate_resources(const std::vector<PlannedRun>& runs, std::si
   return e;
 }
 
-std::size_t tin_vertex_allowance(const Scene& scene, std::size_t stamps, bool replay) {
-  const double v =
-      kTinAllowanceFactor * model_vertices(scene, static_cast<double>(stamps), replay) + kTinAllowanceSlack;
+std::size_t tin_vertex_allowance(const Scene& scene, std::size_t stamps, bool replay,
+                                 std::uint64_t memory_limit_bytes) {
+  double v = kTinAllowanceFactor * model_vertices(scene, static_cast<double>(stamps), replay) + kTinAllowanceSlack;
+  if (memory_limit_bytes > 0) v = std::min(v, static_cast<double>(memory_limit_bytes) / kTinBytesPerVertex);
   return v >= 1e18 ? std::size_t{1} << 60 : static_cast<std::size_t>(v);
 }
 
@@ -230,15 +231,15 @@ std::optional<std::uint64_t> parse_memory_size(const std::string& text) {
   return static_cast<std::uint64_t>(bytes);
 }
 
-void preflight(const ResourceEstimate& estimate, std::optional<std::uint64_t> max_memory) {
+std::uint64_t preflight(const ResourceEstimate& estimate, std::optional<std::uint64_t> max_memory) {
   const ResourceItem* largest = estimate.largest();
   {
     std::lock_guard<std::mutex> lock(context_mutex);
     context = largest ? describe(*largest) : std::string();
   }
-  if (!largest) return;
-  const double total = estimate.bytes();
   const std::optional<std::uint64_t> available = max_memory ? max_memory : available_memory_bytes();
+  if (!largest) return available.value_or(0);
+  const double total = estimate.bytes();
   const std::string limit_name =
       max_memory ? "--max-memory (" + format_bytes(static_cast<double>(*max_memory)) + ")"
                  : "the memory available (" + (available ? format_bytes(static_cast<double>(*available)) : "?") + ")";
@@ -258,6 +259,7 @@ void preflight(const ResourceEstimate& estimate, std::optional<std::uint64_t> ma
   if (total > kLargeRunBytes || (available && total > 0.5 * static_cast<double>(*available)))
     std::fprintf(stderr, "sandbench: warning: a large run: about %s of %s: %s\n", format_bytes(total).c_str(),
                  limit_name.c_str(), parts.c_str());
+  return available.value_or(0);
 }
 
 std::string out_of_memory_context() {

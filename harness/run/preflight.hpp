@@ -46,8 +46,8 @@ ResourceEstimate estimate_resources(const std::vector<PlannedRun>& runs, std::si
 
 // How many vertices a TIN run of the scene may add to its initial model before it is stopped:
 // a generous multiple of the estimate (refinement at its finest length over the disturbed
-// area, and the stamps' contours).
-std::size_t tin_vertex_allowance(const Scene& scene, std::size_t stamps, bool replay);
+// area, and the stamps' contours), and never more than `memory_limit_bytes` holds (0: no limit).
+std::size_t tin_vertex_allowance(const Scene& scene, std::size_t stamps, bool replay, std::uint64_t memory_limit_bytes);
 
 // Bytes the process may still allocate: /proc/meminfo's MemAvailable, less when the cgroup's
 // memory.max leaves less; nullopt when neither can be read.
@@ -61,7 +61,8 @@ std::optional<std::uint64_t> parse_memory_size(const std::string& text);
 // exceeds `max_memory` (when given) or else the available memory; prints a warning on stderr
 // when it exceeds kLargeRunBytes or half the limit. Remembers the largest item for
 // out_of_memory_context(). Call once, before the model is allocated.
-void preflight(const ResourceEstimate& estimate, std::optional<std::uint64_t> max_memory);
+// Returns the limit it applied (0 when none was known).
+std::uint64_t preflight(const ResourceEstimate& estimate, std::optional<std::uint64_t> max_memory);
 inline constexpr double kLargeRunBytes = 2.0 * (1u << 30);
 
 // What the last pre-flight found largest ("grid.cell_m: dense grid nodes, 9e8 elements,

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "common/format_bytes.hpp"
 #include "common/input_error.hpp"
 #include "harness/run/backends.hpp"
 #include "harness/run/preflight.hpp"
@@ -81,8 +82,12 @@ VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_pr
   prepared.scene = variant_scene(v, base.scene);
   const Scene& scene = prepared.scene;
   if (v.backend == "tin") {
-    prepared.max_added_vertices = tin_vertex_allowance(scene, base.schedule.stamps.size(), base.replay);
-    prepared.vertex_bound_reason = "tin.refine_m and the area the stroke disturbs";
+    prepared.max_added_vertices =
+        tin_vertex_allowance(scene, base.schedule.stamps.size(), base.replay, base.memory_limit_bytes);
+    prepared.vertex_bound_reason =
+        "8 x the vertices of tin.refine_m over the area the stroke disturbs, at most what " +
+        (base.memory_limit_bytes ? format_bytes(static_cast<double>(base.memory_limit_bytes)) : std::string("memory")) +
+        " holds";
   }
   prepared.rule = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg, scene.erosion.rule);
 

@@ -259,6 +259,7 @@ TEST(Preflight, EstimatesNameTheirKeysAndLargeRunsWarn) {
   EXPECT_GT(two.bytes(), e.bytes() + 0.39 * 3001.0 * 3001.0);
   EXPECT_NEAR(e.largest()->bytes, 3001.0 * 3001.0 * 10.0, 1.0);
   EXPECT_THROW(sb::preflight(e, std::uint64_t{1} << 20), sb::InputError);
+  EXPECT_EQ(sb::preflight(e, std::uint64_t{1} << 40), std::uint64_t{1} << 40);
   EXPECT_TRUE(contains(sb::out_of_memory_context(), "grid.cell_m, domain.size_m")) << sb::out_of_memory_context();
   EXPECT_NO_THROW(sb::preflight(e, std::uint64_t{1} << 40));
   EXPECT_EQ(sb::parse_memory_size("1.5G"), std::uint64_t{3} << 29);
@@ -280,7 +281,9 @@ TEST(Preflight, ATinThatGrowsPastItsAllowanceStopsWithAMessage) {
     EXPECT_TRUE(contains(e.what(), "past the 10 it may add by the pre-flight's estimate (a test's bound)")) << e.what();
   }
   // The real allowance is far above what the shipped trench needs.
-  EXPECT_GT(sb::tin_vertex_allowance(s, p.schedule.stamps.size(), false), 200000u);
+  EXPECT_GT(sb::tin_vertex_allowance(s, p.schedule.stamps.size(), false, 0), 200000u);
+  // And never more than the memory limit holds (290 bytes a vertex).
+  EXPECT_EQ(sb::tin_vertex_allowance(s, p.schedule.stamps.size(), false, 290000), 1000u);
 }
 
 }  // namespace
