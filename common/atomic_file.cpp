@@ -1,5 +1,6 @@
 #include "common/atomic_file.hpp"
 
+#include <fcntl.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -79,6 +80,21 @@ std::string output_path_problem(const fs::path& target, const std::vector<fs::pa
   const fs::file_status st = fs::symlink_status(target, ec);
   if (fs::exists(st) && st.type() != fs::file_type::regular)
     return target.string() + " is " + kind_of(st.type()) + "; the output must be a regular file, new or to be replaced";
+  // Writable by its mode is not enough (/proc, a read-only mount): try to create the temporary
+  // file the write will use, and remove it again.
+  const fs::path probe = fs::path(target.string() + ".tmp" + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0 && errno != EEXIST) {
+    // A directory that exists yet answers "no such file" is a pseudo-file system.
+    const std::string why = errno == ENOENT ? "its file system does not allow new files (as /proc and /sys)"
+                                            : std::string(std::strerror(errno));
+    return "cannot create files in directory " + dir.string() + " (of " + target.string() + "): " + why +
+           "; choose another directory";
+  }
+  if (fd >= 0) {
+    ::close(fd);
+    ::unlink(probe.c_str());
+  }
   return {};
 }
 

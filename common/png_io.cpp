@@ -79,7 +79,11 @@ namespace {
 constexpr double kMaxDeflateRatio = 1032.0;
 }  // namespace
 
-Png16 read_png16(const std::filesystem::path& file, const std::string& field) {
+namespace {
+
+// The whole image, or (header_only) its size and channels with no pixels decoded.
+Png16 read_png16_file(const std::filesystem::path& file, const std::string& field, bool header_only,
+                      std::size_t* channels_out) {
   const std::string what = "scene: " + field + " = \"" + file.string() + "\"";
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) {
@@ -108,11 +112,16 @@ Png16 read_png16(const std::filesystem::path& file, const std::string& field) {
     out.height = png_get_image_height(png, info);
     if (out.width < 2 || out.height < 2) throw InputError(what + " must be at least 2x2 pixels");
     const std::size_t channels = type == PNG_COLOR_TYPE_GRAY ? 1 : 2;
+    if (channels_out) *channels_out = channels;
     const std::size_t row_bytes = out.width * channels * 2;
     if (static_cast<double>(row_bytes) * static_cast<double>(out.height) > kMaxDeflateRatio * file_bytes)
       throw InputError(what + " declares " + std::to_string(out.width) + "x" + std::to_string(out.height) +
                        " pixels, more than its " + std::to_string(static_cast<long long>(file_bytes)) +
                        " bytes can hold: the file is truncated or corrupt");
+    if (header_only) {
+      png_destroy_read_struct(&png, &info, nullptr);
+      return out;
+    }
     // Adam7-interlaced files are stored in seven passes; libpng reassembles them when asked.
     const int passes = png_set_interlace_handling(png);
     png_read_update_info(png, info);
@@ -135,6 +144,18 @@ Png16 read_png16(const std::filesystem::path& file, const std::string& field) {
   }
   png_destroy_read_struct(&png, &info, nullptr);
   return out;
+}
+
+}  // namespace
+
+Png16 read_png16(const std::filesystem::path& file, const std::string& field) {
+  return read_png16_file(file, field, /*header_only=*/false, nullptr);
+}
+
+Png16Size read_png16_size(const std::filesystem::path& file, const std::string& field) {
+  std::size_t channels = 1;
+  const Png16 header = read_png16_file(file, field, /*header_only=*/true, &channels);
+  return {header.width, header.height, channels};
 }
 
 void write_png16(const std::filesystem::path& file, const Png16& image,

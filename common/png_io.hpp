@@ -21,6 +21,13 @@ constexpr std::uint32_t kMaxPngSide = 32768;
 // (checked before any allocation). Interlaced (Adam7) files are read correctly.
 // Cost: O(pixels) time, 2 bytes per pixel and channel of transient memory.
 Png16 read_png16(const std::filesystem::path& file, const std::string& field);
+// What read_png16 would read, from the header alone (the same checks, no pixels decoded):
+// for estimating memory before reading. O(1).
+struct Png16Size {
+  std::size_t width = 0, height = 0;
+  std::size_t channels = 1;  // 1 grey, 2 grey and alpha
+};
+Png16Size read_png16_size(const std::filesystem::path& file, const std::string& field);
 // `text` entries become tEXt chunks (key, value).
 void write_png16(const std::filesystem::path& file, const Png16& image,
                  const std::vector<std::pair<std::string, std::string>>& text = {});

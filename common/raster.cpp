@@ -8,14 +8,20 @@
 
 namespace sb {
 
+std::array<std::size_t, 2> Raster::shape_covering(const Aabb2& box, double spacing_m) {
+  const Vec2 size = box.hi - box.lo;
+  // The last sample lands on the box's far edge when the size is a whole number of steps.
+  return {static_cast<std::size_t>(std::floor(size.x() / spacing_m + 1e-9)) + 1,
+          static_cast<std::size_t>(std::floor(size.y() / spacing_m + 1e-9)) + 1};
+}
+
 Raster Raster::covering(const Aabb2& box, double spacing_m) {
   Raster r;
   r.origin_m = box.lo;
   r.spacing_m = spacing_m;
-  const Vec2 size = box.hi - box.lo;
-  // The last sample lands on the box's far edge when the size is a whole number of steps.
-  r.nx = static_cast<std::size_t>(std::floor(size.x() / spacing_m + 1e-9)) + 1;
-  r.ny = static_cast<std::size_t>(std::floor(size.y() / spacing_m + 1e-9)) + 1;
+  const auto shape = shape_covering(box, spacing_m);
+  r.nx = shape[0];
+  r.ny = shape[1];
   r.values.assign(r.nx * r.ny, 0.0);
   return r;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -122,7 +123,7 @@ PileShape measure_pile(const Raster& h, const Vec2& centre, double base_m) {
   double peak = base_m;
   for (double v : h.values) peak = std::max(peak, v);
   shape.height_m = peak - base_m;
-  if (shape.height_m <= 0.0) return shape;
+  if (!(shape.height_m > 0.0)) return shape;
   // Flank: height against radius where the pile is between 20% and 80% of its height.
   std::vector<double> radius, height;
   for (std::size_t iy = 0; iy < h.ny; ++iy)
@@ -151,6 +152,9 @@ PileShape measure_pile(const Raster& h, const Vec2& centre, double base_m) {
   double foot_mean = 0.0;
   for (double r : foot) foot_mean += r;
   shape.radius_m = foot_mean / static_cast<double>(foot.size());
+  // A ray that runs out of the raster before it finds the foot: the pile is cut by the border.
+  shape.found = std::all_of(foot.begin(), foot.end(), [&](double r) { return r < max_r; }) &&
+                std::isfinite(shape.flank_angle_deg) && std::isfinite(shape.roundness);
   return shape;
 }
 
@@ -230,6 +234,7 @@ PlaneShape measure_plane(const Raster& h) {
   }
   const double det = sxx * syy - sxy * sxy;
   if (!(det > 0.0)) return shape;
+  shape.fitted = true;
   const double gx = (sxz * syy - syz * sxy) / det, gy = (syz * sxx - sxz * sxy) / det;
   shape.slope_deg = rad_to_deg(std::atan(std::hypot(gx, gy)));
   shape.azimuth_deg = rad_to_deg(std::atan2(-gy, -gx));
@@ -256,11 +261,63 @@ PlaneShape measure_plane(const Raster& h) {
   return shape;
 }
 
+std::optional<std::string> reference_problem(const Scene& scene, const StampSchedule& schedule, const Raster& lattice) {
+  if (schedule.stamps.empty()) return "the stroke has no stamps";
+  const Aabb2 box{lattice.origin_m, lattice.point(lattice.nx - 1, lattice.ny - 1)};
+  auto outside = [&](const Vec2& c, double r) {
+    return c.x() - r < box.lo.x() || c.x() + r > box.hi.x() || c.y() - r < box.lo.y() || c.y() + r > box.hi.y();
+  };
+  auto text = [](double v) {
+    std::ostringstream o;
+    o << v;
+    return o.str();
+  };
+  const ToolStamp& first = schedule.stamps.front();
+  switch (scene.reference) {
+    case ReferenceKind::Pile: {
+      const PileSetup pile = pile_setup(scene, schedule);
+      const double radius = std::max(cone_radius(pile.volume_m3, scene.material.tan_critical()), scene.tool.radius_m);
+      if (outside(pile.centre, radius))
+        return "the pile's expected foot (a circle of radius " + text(radius) + " m around (" + text(pile.centre.x()) +
+               ", " + text(pile.centre.y()) +
+               "): the cone of the poured volume, or the pour's tool.radius_m) does not fit in the domain";
+      return std::nullopt;
+    }
+    case ReferenceKind::Crater: {
+      const Aabb2 reach = first.influence_bounds();
+      if (reach.lo.x() < box.lo.x() || reach.hi.x() > box.hi.x() || reach.lo.y() < box.lo.y() ||
+          reach.hi.y() > box.hi.y())
+        return "the crater's footprint and rim band reach beyond the domain";
+      return std::nullopt;
+    }
+    case ReferenceKind::Trench:
+    case ReferenceKind::Ridge: {
+      const auto& path = scene.stroke.path_m;
+      const Vec2 a = path.front() + 0.25 * (path.back() - path.front());
+      const Vec2 b = path.front() + 0.75 * (path.back() - path.front());
+      if (outside(a, 0.0) || outside(b, 0.0))
+        return "the middle half of the stroke, where it is measured, leaves the domain";
+      return std::nullopt;
+    }
+    case ReferenceKind::Plane:
+    case ReferenceKind::None:
+      return std::nullopt;
+  }
+  return std::nullopt;
+}
+
 nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule& schedule, const HeightField& initial,
-                                        const Raster& initial_raster, const Raster& final_raster) {
+                                        const Raster& initial_raster, const Raster& final_raster,
+                                        std::vector<std::string>* warnings) {
   nlohmann::ordered_json j = nlohmann::ordered_json::object();
   if (scene.reference == ReferenceKind::None || schedule.stamps.empty()) return j;
   j["reference"] = to_string(scene.reference);
+  const std::string kind = to_string(scene.reference);
+  auto absent = [&](const std::string& why) {
+    if (warnings) warnings->push_back("the " + kind + " reference metrics are absent: " + why);
+    return j;
+  };
+  if (const auto problem = reference_problem(scene, schedule, final_raster)) return absent(*problem);
   if (auto ref = reference_raster(scene, schedule, initial, final_raster)) {
     const RasterDifference d = compare_rasters(final_raster, *ref);
     j["reference.rmse_m"] = d.rmse_m;
@@ -271,6 +328,11 @@ nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule&
     const PileSetup pile = pile_setup(scene, schedule);
     const PileShape p =
         measure_pile(final_raster, pile.centre, pile.on_cone ? scene.terrain.height_m : initial(pile.centre));
+    if (!p.found) {
+      j.erase("reference.rmse_m");
+      j.erase("reference.max_error_m");
+      return absent("no pile was found whose foot lies within the domain around the pour point");
+    }
     const double volume = pile.volume_m3;
     j["pile.flank_angle_deg"] = p.flank_angle_deg;
     j["pile.flank_angle_error_deg"] = p.flank_angle_deg - crit;
@@ -284,6 +346,9 @@ nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule&
     const bool trench = scene.reference == ReferenceKind::Trench;
     const TrenchShape t = trench ? measure_trench(final_raster, initial_raster, path.front(), path.back())
                                  : measure_ridge(final_raster, initial_raster, path.front(), path.back());
+    if (t.sections == 0)
+      return absent(std::string("no cross-section has a ") + (trench ? "wall" : "flank") +
+                    " to fit (the stroke left no " + (trench ? "trench" : "ridge") + " below 80% of its depth)");
     const std::string key = trench ? "trench.wall_" : "ridge.flank_";
     j[key + "angle_deg"] = t.wall_angle_deg;  // the steepest section
     j[key + "angle_mean_deg"] = t.wall_angle_mean_deg;
@@ -297,6 +362,7 @@ nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule&
   }
   if (scene.reference == ReferenceKind::Plane) {
     const PlaneShape p = measure_plane(final_raster);
+    if (!p.fitted) return absent("the middle half of the raster has too few samples for a plane");
     j["plane.slope_deg"] = p.slope_deg;
     j["plane.slope_error_deg"] = p.slope_deg - crit;
     j["plane.azimuth_deg"] = p.azimuth_deg;

@@ -16,6 +16,8 @@
 #include <algorithm>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "common/height_field.hpp"
 #include "common/raster.hpp"
@@ -34,6 +36,7 @@ struct PileShape {
   double roundness = 0.0;        // std / mean of the half-height contour's radius
   double radius_m = 0.0;         // mean radius of the foot (height above base > 1% of peak)
   double height_m = 0.0;         // peak above the base
+  bool found = false;            // a pile above the base whose foot every ray found within the raster
 };
 // Measures a pile standing on a flat base around `centre`.
 PileShape measure_pile(const Raster& heights, const Vec2& centre, double base_m);
@@ -65,12 +68,21 @@ struct PlaneShape {
   // spacings), which the fit averages away: their mean and the steepest.
   double slope_mean_deg = 0.0;
   double slope_max_deg = 0.0;
+  bool fitted = false;  // false: too few samples for a plane
 };
 PlaneShape measure_plane(const Raster& heights);
 
+// Why the scene's reference cannot be measured on this lattice (the pile's expected foot, the
+// crater's rim band or the middle half of a trench's or ridge's stroke not within it), or
+// nullopt when it can.
+std::optional<std::string> reference_problem(const Scene& scene, const StampSchedule& schedule, const Raster& lattice);
+
 // The accuracy metrics (README "Summary metrics") for the scene's reference, as summary entries
-// ("reference.rmse_m", "pile.flank_angle_deg", ...). Empty when the scene has none.
+// ("reference.rmse_m", "pile.flank_angle_deg", ...). Empty when the scene has none. Metrics that
+// cannot be computed (reference_problem, no pile found within the raster, no trench wall, no
+// plane) are absent, never numbers: only "reference" is given, and `warnings` says why.
 nlohmann::ordered_json accuracy_metrics(const Scene& scene, const StampSchedule& schedule, const HeightField& initial,
-                                        const Raster& initial_raster, const Raster& final_raster);
+                                        const Raster& initial_raster, const Raster& final_raster,
+                                        std::vector<std::string>* warnings = nullptr);
 
 }  // namespace sb

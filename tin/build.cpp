@@ -60,6 +60,23 @@ double default_refine_m(const TinOptions& o) {
   return std::min(std::max(h, 0.5 * o.tool_radius_m), 0.05 * extent);
 }
 
+Refinement refinement_lengths(const TinOptions& o) {
+  const TinSpec& spec = o.tin;
+  const double extent = std::max(o.domain.size_m.x(), o.domain.size_m.y());
+  Refinement r;
+  r.refine_m = spec.refine_m > 0.0 ? spec.refine_m : default_refine_m(o);
+  // Never split below what snapping could merge again, nor below a ten-thousandth of the
+  // domain (a 0.4 mm tool must not refine a 30 cm domain to 0.1 mm).
+  const double floor_m = std::max(64.0 * spec.snap_m, 1e-4 * extent);
+  r.refine_m = std::max(r.refine_m, floor_m);
+  // Curvature refinement goes down to refine_min_m (half of refine_m by default), never
+  // below a quarter of refine_m: a tiny tolerance or refine_min_m cannot make the mesh
+  // explode (a 30 um floor on pile.toml ran 4 pours for over 5 minutes).
+  const double fine = spec.refine_min_m > 0.0 ? spec.refine_min_m : 0.5 * r.refine_m;
+  r.fine_m = spec.curvature_tolerance_m > 0.0 ? std::clamp(fine, 0.25 * r.refine_m, r.refine_m) : r.refine_m;
+  return r;
+}
+
 TinTerrain::TinTerrain(const TinOptions& o)
     : domain_(o.domain), box_(o.domain.box()), spec_(o.tin), idle_passes_(o.idle_passes) {
   const double extent = std::max(domain_.size_m.x(), domain_.size_m.y());
@@ -67,17 +84,10 @@ TinTerrain::TinTerrain(const TinOptions& o)
     throw InputError("scene: domain.size_m must be positive and finite for the TIN");
   tool_size_m_ = o.tool_radius_m;
   if (!(tool_size_m_ > 0.0) || !std::isfinite(tool_size_m_)) tool_size_m_ = 0.02 * extent;
-  refine_m_ = spec_.refine_m > 0.0 ? spec_.refine_m : default_refine_m(o);
-  // Never split below what snapping could merge again, nor below a ten-thousandth of the
-  // domain (a 0.4 mm tool must not refine a 30 cm domain to 0.1 mm).
-  const double floor_m = std::max(64.0 * spec_.snap_m, 1e-4 * extent);
-  refine_m_ = std::max(refine_m_, floor_m);
-  // Curvature refinement goes down to refine_min_m (half of refine_m_ by default), never
-  // below a quarter of refine_m_: a tiny tolerance or refine_min_m cannot make the mesh
-  // explode (a 30 um floor on pile.toml ran 4 pours for over 5 minutes).
+  const Refinement refinement = refinement_lengths(o);
+  refine_m_ = refinement.refine_m;
+  fine_m_ = refinement.fine_m;
   curvature_tolerance_m_ = spec_.curvature_tolerance_m;
-  const double fine = spec_.refine_min_m > 0.0 ? spec_.refine_min_m : 0.5 * refine_m_;
-  fine_m_ = curvature_tolerance_m_ > 0.0 ? std::clamp(fine, 0.25 * refine_m_, refine_m_) : refine_m_;
   // A thousandth of the TIN's accuracy: what coarsening may add to an edge's height drop.
   settle_dz_ = 1e-3 * spec_.tolerance_m;
   tan_critical_ = o.material.tan_critical();
@@ -285,6 +295,8 @@ void TinTerrain::build_from_points(const std::vector<Vec3>& points, const Height
 }
 
 }  // namespace detail
+
+Refinement refinement_of(const Scene& scene) { return detail::refinement_lengths(detail::tin_options(scene)); }
 
 std::unique_ptr<Terrain> make_tin_terrain(const Scene& scene, const HeightField& initial) {
   if (scene.tin.initial_points > 0) {

@@ -92,4 +92,13 @@ std::unique_ptr<Terrain> make_tin_terrain(const Scene& scene, const HeightField&
 // TIN of a given size. Throws InputError for points outside the domain or non-finite values.
 std::unique_ptr<Terrain> make_tin_terrain_from_points(const Scene& scene, const std::vector<Vec3>& points);
 
+// The edge lengths a scene's TIN refines to: erosion splits edges longer than refine_m that
+// sand flows across, curvature refinement goes down to fine_m (= refine_m when it is off).
+// What the TIN itself uses; the resource pre-flight estimates vertex counts from them. O(1).
+struct Refinement {
+  double refine_m = 0.0;
+  double fine_m = 0.0;
+};
+Refinement refinement_of(const Scene& scene);
+
 }  // namespace sb::tin

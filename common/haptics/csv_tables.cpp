@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -31,11 +32,33 @@ std::vector<std::string> split(const std::string& line) {
   return out;
 }
 
-bool parses_as_number(const std::string& s) {
+// A line is data when its first cell starts like a number (digits, sign, point, or a word
+// strtod reads, such as inf or nan): those are then parsed strictly and refused with a message,
+// never taken for the header of another table.
+bool starts_like_number(const std::string& s) {
   if (s.empty()) return false;
   char* end = nullptr;
   std::strtod(s.c_str(), &end);
-  return end && *end == '\0';
+  return end != s.c_str() || s.find_first_of("0123456789+-.") == 0;
+}
+
+bool all_digits(const std::string& s, std::size_t from) {
+  return from < s.size() && s.find_first_not_of("0123456789", from) == std::string::npos;
+}
+
+// The cell as it can be printed: control bytes (a NUL among them) as \xNN.
+std::string printable(const std::string& s) {
+  std::string out;
+  for (const unsigned char c : s) {
+    if (c < 0x20 || c == 0x7f) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    } else {
+      out.push_back(static_cast<char>(c));
+    }
+  }
+  return out;
 }
 
 std::string join(const std::vector<std::string>& v) {
@@ -71,7 +94,12 @@ CsvFile parse_csv_tables(const std::string& text, const std::string& name) {
       continue;
     }
     std::vector<std::string> cells = split(s);
-    if (!parses_as_number(cells[0])) {
+    if (!starts_like_number(cells[0])) {
+      for (const CsvTable& earlier : f.tables)
+        if (earlier.header == cells)
+          csv_fail(f, line,
+                   "a second table with the header " + printable(join(cells)) + " (the first is at line " +
+                       std::to_string(earlier.header_line) + "); a file holds each table once");
       CsvTable t;
       t.header = std::move(cells);
       t.header_line = line;
@@ -98,36 +126,68 @@ CsvFile read_csv_tables(const std::string& path) {
   return parse_csv_tables(text.str(), path);
 }
 
-double csv_number(const CsvFile& f, const CsvTable& t, std::size_t row, std::size_t col) {
-  const std::string& s = t.rows[row][col];
-  char* end = nullptr;
+bool parse_decimal(const std::string& s, double& value) {
+  // [+-] digits [. digits] [(e|E) [+-] digits], with digits on at least one side of the point.
+  std::size_t i = 0;
+  if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
+  const std::size_t int_begin = i;
+  while (i < s.size() && s[i] >= '0' && s[i] <= '9') ++i;
+  std::size_t digits = i - int_begin;
+  if (i < s.size() && s[i] == '.') {
+    const std::size_t frac_begin = ++i;
+    while (i < s.size() && s[i] >= '0' && s[i] <= '9') ++i;
+    digits += i - frac_begin;
+  }
+  if (digits == 0) return false;
+  if (i < s.size() && (s[i] == 'e' || s[i] == 'E')) {
+    ++i;
+    if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
+    if (!all_digits(s, i)) return false;
+    i = s.size();
+  }
+  if (i != s.size()) return false;  // trailing bytes, a NUL among them
   errno = 0;
-  const double v = std::strtod(s.c_str(), &end);
+  const double v = std::strtod(s.c_str(), nullptr);
   // ERANGE also flags underflow (a denormal like 5e-324, which recorded sessions can hold):
   // only an overflow to infinity is refused.
-  const bool overflow = errno == ERANGE && std::fabs(v) > 1.0;
-  if (s.empty() || *end != '\0' || overflow || !std::isfinite(v))
-    csv_fail(f, t.lines[row], "column " + t.header[col] + " = '" + s + "' is not a finite number");
+  if ((errno == ERANGE && std::fabs(v) > 1.0) || !std::isfinite(v)) return false;
+  value = v;
+  return true;
+}
+
+double csv_number(const CsvFile& f, const CsvTable& t, std::size_t row, std::size_t col) {
+  const std::string& s = t.rows[row][col];
+  double v = 0.0;
+  if (!parse_decimal(s, v))
+    csv_fail(f, t.lines[row],
+             "column " + t.header[col] + " = '" + printable(s) + "' is not a finite decimal number (e.g. -1.5e-3)");
   return v;
+}
+
+void csv_check_time_order(const CsvFile& f, const CsvTable& t, std::size_t row, std::size_t col, double previous,
+                          double value) {
+  if (row > 0 && value < previous)
+    csv_fail(f, t.lines[row],
+             "column " + t.header[col] + " = " + t.rows[row][col] +
+                 " goes back in time (previous row: " + t.rows[row - 1][col] + ")");
 }
 
 std::uint32_t csv_mask(const CsvFile& f, const CsvTable& t, std::size_t row, std::size_t col) {
   const std::string& s = t.rows[row][col];
-  char* end = nullptr;
   errno = 0;
-  const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
-  if (s.empty() || s[0] == '-' || *end != '\0' || errno == ERANGE || v > 0xffffffffULL)
-    csv_fail(f, t.lines[row], "column " + t.header[col] + " = '" + s + "' is not an integer in [0, 4294967295]");
+  const unsigned long long v = all_digits(s, 0) ? std::strtoull(s.c_str(), nullptr, 10) : 0;
+  if (!all_digits(s, 0) || errno == ERANGE || v > 0xffffffffULL)
+    csv_fail(f, t.lines[row],
+             "column " + t.header[col] + " = '" + printable(s) + "' is not an integer in [0, 4294967295]");
   return static_cast<std::uint32_t>(v);
 }
 
 std::size_t csv_index(const CsvFile& f, const CsvTable& t, std::size_t row, std::size_t col) {
   const std::string& s = t.rows[row][col];
-  char* end = nullptr;
   errno = 0;
-  const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
-  if (s.empty() || s[0] == '-' || *end != '\0' || errno == ERANGE || v > 1000000000ULL)
-    csv_fail(f, t.lines[row], "column " + t.header[col] + " = '" + s + "' is not an integer in [0, 1e9]");
+  const unsigned long long v = all_digits(s, 0) ? std::strtoull(s.c_str(), nullptr, 10) : 0;
+  if (!all_digits(s, 0) || errno == ERANGE || v > 1000000000ULL)
+    csv_fail(f, t.lines[row], "column " + t.header[col] + " = '" + printable(s) + "' is not an integer in [0, 1e9]");
   return static_cast<std::size_t>(v);
 }
 

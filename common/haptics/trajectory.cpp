@@ -19,9 +19,7 @@ Trajectory trajectory_from(const CsvFile& file) {
     s.t_s = csv_number(file, *t, r, 0);
     s.position_m = {csv_number(file, *t, r, 1), csv_number(file, *t, r, 2), csv_number(file, *t, r, 3)};
     s.buttons = csv_mask(file, *t, r, 4);
-    if (!out.samples.empty() && s.t_s < out.samples.back().t_s)
-      csv_fail(file, t->lines[r],
-               "column t = " + t->rows[r][0] + " goes back in time (previous row: " + t->rows[r - 1][0] + ")");
+    if (!out.samples.empty()) csv_check_time_order(file, *t, r, 0, out.samples.back().t_s, s.t_s);
     out.samples.push_back(s);
   }
   return out;

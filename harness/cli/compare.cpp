@@ -85,7 +85,7 @@ void compare_command(const CompareOptions& o) {
   const std::filesystem::path dir = o.out;
   if (!dir.empty()) check_output_directory(dir, "--out", {o.in.scene, o.in.replay});  // --out '' fails its validator
 
-  PreparedScene prepared = prepare_input(o.in);
+  PreparedScene prepared = prepare_input(o.in, variants);
   // A folder being written holds this marker until its last picture is there, so a killed
   // compare leaves a folder that says it is incomplete.
   const std::filesystem::path marker = dir / "INCOMPLETE";

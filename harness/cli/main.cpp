@@ -5,6 +5,7 @@
 
 #include "common/input_error.hpp"
 #include "harness/cli/commands.hpp"
+#include "harness/run/preflight.hpp"
 #include "sandbench/version.hpp"
 
 namespace {
@@ -81,7 +82,10 @@ int main(int argc, char** argv) {
     std::cerr << "sandbench: error: " << e.what() << "\n";
     return 2;
   } catch (const std::bad_alloc&) {
-    std::cerr << "sandbench: error: out of memory; use a smaller scene (fewer stamps, a coarser grid or raster)\n";
+    // Name the input behind the largest allocation the pre-flight or a reader foresaw.
+    const std::string cause = sb::out_of_memory_context();
+    std::cerr << "sandbench: error: out of memory" << (cause.empty() ? "" : " (the largest part: " + cause + ")")
+              << "; use a smaller scene (fewer stamps, a coarser grid or raster) or a smaller input\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "sandbench: internal error: " << e.what() << "\n";

@@ -22,8 +22,8 @@ struct RunOptions {
 };
 
 void run_command(const RunOptions& o) {
-  PreparedScene prepared = prepare_input(o.in);
   const Variant variant = parse_variant(o.backend, "--backend");
+  PreparedScene prepared = prepare_input(o.in, {variant});
   const std::filesystem::path out =
       o.out.empty() ? default_run_path(o.in.scene, variant.label) : std::filesystem::path(o.out);
   check_output_path(out, "--out", {o.in.scene, o.in.replay});  // the default name too; --out '' fails its validator

@@ -3,6 +3,7 @@
 #include <charconv>
 
 #include "common/atomic_file.hpp"
+#include "harness/run/preflight.hpp"
 
 namespace sb::cli {
 
@@ -33,6 +34,24 @@ CLI::Validator image_size(int lo, int hi) {
         return {};
       },
       "WxH");
+}
+
+CLI::Validator memory_size() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        if (!parse_memory_size(text))
+          return "\"" + text + "\" must be a size in bytes > 0, optionally with K, M, G or T (e.g. 8G, 512M)";
+        return {};
+      },
+      "SIZE");
+}
+
+void add_max_memory_option(CLI::App& cmd, std::optional<std::uint64_t>& bytes) {
+  cmd.add_option_function<std::string>(
+         "--max-memory", [&bytes](const std::string& text) { bytes = parse_memory_size(text); },
+         "Refuse a run whose estimated memory exceeds this (bytes, or with K, M, G, T; default: the memory "
+         "available)")
+      ->check(memory_size());
 }
 
 std::pair<int, int> parse_image_size(const std::string& text) {

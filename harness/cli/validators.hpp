@@ -3,7 +3,9 @@
 // CLI::ValidationError: the message names the option and what it accepts, and main turns
 // it into exit code 2 before anything is read or written.
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <type_traits>
 
@@ -33,6 +35,10 @@ CLI::Validator output_file();
 CLI::Validator output_directory();
 // "WxH", each a whole number in [lo, hi].
 CLI::Validator image_size(int lo, int hi);
+// --max-memory: a byte count, or a number with K, M, G or T (powers of 1024), > 0; e.g. 8G.
+CLI::Validator memory_size();
+// Adds --max-memory to a command that takes a scene; `bytes` is set when it is given.
+void add_max_memory_option(CLI::App& cmd, std::optional<std::uint64_t>& bytes);
 // Splits a WxH that image_size accepted.
 std::pair<int, int> parse_image_size(const std::string& text);
 

@@ -3,6 +3,7 @@
 #include <hdf5.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -16,7 +17,9 @@
 #include <stdexcept>
 
 #include "common/atomic_file.hpp"
+#include "common/format_bytes.hpp"
 #include "common/input_error.hpp"
+#include "harness/run/preflight.hpp"
 #include "sandbench/version.hpp"
 
 namespace sb {
@@ -365,17 +368,67 @@ std::vector<double> read_double_attribute(hid_t obj, const std::string& name) {
   return v;
 }
 
+std::string exact_count(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.0f", v);
+  return buf;
+}
+
+// The shape a dataset must have: its rank, and (when not 0) its last dimension.
+struct Shape {
+  int rank = 1;
+  hsize_t columns = 0;
+  std::string text;  // "n x 3", for messages
+};
+
+// Reads a numeric dataset whole after checking its shape, and that its declared size is one
+// this process can hold (a small file can declare a huge chunked dataset): anything else is an
+// InputError naming the dataset. `integers`: the file type must be an integer type (indices
+// are never rounded from floating point).
 template <typename T>
-std::vector<T> read_dataset(hid_t parent, const std::string& name, hid_t mem_type, std::vector<hsize_t>& dims) {
+std::vector<T> read_dataset(hid_t parent, const std::string& name, hid_t mem_type, std::vector<hsize_t>& dims,
+                            const Shape& shape, bool integers = false, double max_elements = 0.0) {
   Handle set(H5Dopen2(parent, name.c_str(), H5P_DEFAULT), H5Dclose, "open dataset " + name);
   Handle space(H5Dget_space(set), H5Sclose, "space of " + name);
-  dims.assign(static_cast<std::size_t>(H5Sget_simple_extent_ndims(space)), 0);
+  Handle type(H5Dget_type(set), H5Tclose, "type of " + name);
+  const H5T_class_t cls = H5Tget_class(type);
+  if (integers ? cls != H5T_INTEGER : (cls != H5T_FLOAT && cls != H5T_INTEGER))
+    throw InputError(name + " must hold " + (integers ? "integers" : "numbers"));
+  const int rank = H5Sget_simple_extent_ndims(space);
+  if (rank != shape.rank)
+    throw InputError(name + " must be a " + shape.text + " dataset (it has rank " + std::to_string(rank) + ")");
+  dims.assign(static_cast<std::size_t>(rank), 0);
   H5Sget_simple_extent_dims(space, dims.data(), nullptr);
-  std::size_t count = 1;
-  for (hsize_t d : dims) count *= d;
-  std::vector<T> data(count);
+  if (shape.columns != 0 && dims.back() != shape.columns)
+    throw InputError(name + " must be a " + shape.text + " dataset (it has " + std::to_string(dims.back()) +
+                     " columns)");
+  double count = 1.0;
+  for (hsize_t d : dims) count *= static_cast<double>(d);
+  if (max_elements > 0.0 && count > max_elements)
+    throw InputError(name + " declares " + exact_count(count) + " values, more than a run writes (at most " +
+                     exact_count(max_elements) + ")");
+  const std::optional<std::uint64_t> available = available_memory_bytes();
+  if (available && count * sizeof(T) > static_cast<double>(*available))
+    throw InputError(name + " declares " + exact_count(count) + " values (" + format_bytes(count * sizeof(T)) +
+                     "), more than the memory available (" + format_bytes(static_cast<double>(*available)) + ")");
+  set_out_of_memory_context(name + ": " + exact_count(count) + " values, " + format_bytes(count * sizeof(T)));
+  std::vector<T> data(static_cast<std::size_t>(count));
   if (count > 0) check(H5Dread(set, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()), "read " + name);
   return data;
+}
+
+// What a run file may hold: coordinates and heights within a scene's ranges (domain.origin_m
+// and stroke.z_m within 1e9, domain.size_m at most 1e6), and a raster spacing that the
+// coordinates can resolve (at least 1e-12 of the origin's magnitude, and 1e-9 m).
+constexpr double kMaxMagnitude = 1e10;
+// A stroke has at most 1e7 stamps and its settling at most 1e8 / 64 steps.
+constexpr double kMaxStepRows = 2e7;
+constexpr double kMinSpacing = 1e-9, kMaxSpacing = 1e7;
+
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return buf;
 }
 
 // A raster whose shape, origin, spacing and values can be drawn and exported: anything else
@@ -383,25 +436,51 @@ std::vector<T> read_dataset(hid_t parent, const std::string& name, hid_t mem_typ
 Raster read_raster(hid_t file, const std::string& name) {
   std::vector<hsize_t> dims;
   Raster r;
-  r.values = read_dataset<double>(file, name, H5T_NATIVE_DOUBLE, dims);
-  if (dims.size() != 2 || dims[0] < 1 || dims[1] < 1)
-    throw InputError(name + " must be a 2-D dataset of at least 1 x 1 values");
+  r.values =
+      read_dataset<double>(file, name, H5T_NATIVE_DOUBLE, dims, {2, 0, "2-D (rows along y)"}, false, kMaxRasterSamples);
+  if (dims[0] < 2 || dims[1] < 2)
+    throw InputError(name + " has " + std::to_string(dims[0]) + " x " + std::to_string(dims[1]) +
+                     " values; a raster has at least 2 x 2");
   r.ny = dims[0];
   r.nx = dims[1];
   Handle set(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose, "open " + name);
   const auto origin = read_double_attribute(set, "origin_m");
   const auto spacing = read_double_attribute(set, "spacing_m");
-  if (origin.size() != 2 || !std::isfinite(origin[0]) || !std::isfinite(origin[1]))
-    throw InputError(name + ": attribute origin_m must be 2 finite numbers");
+  if (origin.size() != 2 || !(std::fabs(origin[0]) < kMaxMagnitude) || !(std::fabs(origin[1]) < kMaxMagnitude))
+    throw InputError(name + ": attribute origin_m must be 2 finite numbers within (-1e10, 1e10) m");
   r.origin_m = Vec2(origin[0], origin[1]);
   r.spacing_m = spacing.at(0);
-  if (spacing.size() != 1 || !std::isfinite(r.spacing_m) || !(r.spacing_m > 0.0))
-    throw InputError(name + ": attribute spacing_m must be one finite number > 0");
+  const double finest = std::max(kMinSpacing, 1e-12 * r.origin_m.cwiseAbs().maxCoeff());
+  if (spacing.size() != 1 || !(r.spacing_m >= finest) || !(r.spacing_m <= kMaxSpacing))
+    throw InputError(name + ": attribute spacing_m = " + number_text(r.spacing_m) + " must be one number in [" +
+                     number_text(finest) + ", 1e7] m (at least 1e-9 m and 1e-12 of the origin's magnitude)");
+  const Vec2 far = r.point(r.nx - 1, r.ny - 1);
+  if (!(std::fabs(far.x()) < kMaxMagnitude) || !(std::fabs(far.y()) < kMaxMagnitude))
+    throw InputError(name + ": its " + std::to_string(r.ny) + " x " + std::to_string(r.nx) +
+                     " samples at spacing_m = " + number_text(r.spacing_m) + " reach beyond (-1e10, 1e10) m");
   for (std::size_t i = 0; i < r.values.size(); ++i)
-    if (!std::isfinite(r.values[i]))
+    if (!(std::fabs(r.values[i]) < kMaxMagnitude))
       throw InputError(name + ": value at row " + std::to_string(i / r.nx) + ", column " + std::to_string(i % r.nx) +
-                       " is not finite");
+                       " = " + number_text(r.values[i]) + " is not a finite height within (-1e10, 1e10) m");
   return r;
+}
+
+// Vertex indices of a mesh dataset (triangles or constrained edges): each must name a vertex.
+template <std::size_t N>
+std::vector<std::array<std::uint32_t, N>> read_indices(hid_t file, const std::string& name, std::size_t vertices) {
+  std::vector<hsize_t> dims;
+  const auto raw = read_dataset<std::int64_t>(file, name, H5T_NATIVE_INT64, dims,
+                                              {2, N, "n x " + std::to_string(N) + " (vertex indices)"}, true);
+  std::vector<std::array<std::uint32_t, N>> out(dims[0]);
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const std::int64_t v = raw[i];
+    if (v < 0 || static_cast<std::uint64_t>(v) >= vertices)
+      throw InputError(name + ": row " + std::to_string(i / N) + " names vertex " + std::to_string(v) +
+                       ", not one of the " + std::to_string(vertices) + " vertices (0 to " +
+                       (vertices ? std::to_string(vertices - 1) : std::string("none")) + ")");
+    out[i / N][i % N] = static_cast<std::uint32_t>(v);
+  }
+  return out;
 }
 
 herr_t collect_attribute_name(hid_t, const char* name, const H5A_info_t*, void* out) {
@@ -474,38 +553,40 @@ RunFile read_run_file(const std::filesystem::path& path) {
       std::vector<std::string> fields;
       H5Literate(steps, H5_INDEX_NAME, H5_ITER_INC, nullptr, collect_link_name, &fields);
       std::vector<hsize_t> dims;
-      for (const auto& f : fields) out.steps[f] = read_dataset<double>(steps, f, H5T_NATIVE_DOUBLE, dims);
+      std::optional<std::size_t> rows;
+      for (const auto& f : fields) {
+        out.steps[f] = read_dataset<double>(steps, "/steps/" + f, H5T_NATIVE_DOUBLE, dims,
+                                            {1, 0, "1-D (one value per step)"}, false, kMaxStepRows);
+        if (rows && *rows != out.steps[f].size())
+          throw InputError("/steps/" + f + " has " + std::to_string(out.steps[f].size()) +
+                           " rows; the other steps have " + std::to_string(*rows));
+        rows = out.steps[f].size();
+      }
     }
     out.initial_raster = read_raster(file, "/initial/raster");
     out.final_raster = read_raster(file, "/final/raster");
+    const Raster& a = out.initial_raster;
+    const Raster& b = out.final_raster;
+    if (a.nx != b.nx || a.ny != b.ny || a.origin_m != b.origin_m || a.spacing_m != b.spacing_m)
+      throw InputError("/final/raster (" + std::to_string(b.ny) + " x " + std::to_string(b.nx) +
+                       ") is not on the lattice of /initial/raster (" + std::to_string(a.ny) + " x " +
+                       std::to_string(a.nx) + "): same shape, origin_m and spacing_m");
     std::vector<hsize_t> dims;
-    const auto xyz = read_dataset<double>(file, "/final/mesh/vertices", H5T_NATIVE_DOUBLE, dims);
-    if (!xyz.empty() && (dims.size() != 2 || dims[1] != 3))
-      throw InputError("/final/mesh/vertices must be an n x 3 dataset");
+    const auto xyz =
+        read_dataset<double>(file, "/final/mesh/vertices", H5T_NATIVE_DOUBLE, dims, {2, 3, "n x 3 (x, y, z)"});
+    out.mesh.vertices.reserve(dims[0]);
     for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) {
-      if (!std::isfinite(xyz[i]) || !std::isfinite(xyz[i + 1]) || !std::isfinite(xyz[i + 2]))
-        throw InputError("/final/mesh/vertices: vertex " + std::to_string(i / 3) + " is not finite");
+      if (!(std::fabs(xyz[i]) < kMaxMagnitude) || !(std::fabs(xyz[i + 1]) < kMaxMagnitude) ||
+          !(std::fabs(xyz[i + 2]) < kMaxMagnitude))
+        throw InputError("/final/mesh/vertices: vertex " + std::to_string(i / 3) +
+                         " is not finite within (-1e10, 1e10) m");
       out.mesh.vertices.emplace_back(xyz[i], xyz[i + 1], xyz[i + 2]);
     }
     const std::size_t n = out.mesh.vertices.size();
     // Indices must name vertices: renderers and exporters index with them.
-    auto index = [&](const std::string& what, std::uint32_t v, std::size_t row) {
-      if (v >= n)
-        throw InputError(what + ": row " + std::to_string(row) + " names vertex " + std::to_string(v) + " of " +
-                         std::to_string(n));
-      return v;
-    };
-    const auto tri = read_dataset<std::uint32_t>(file, "/final/mesh/triangles", H5T_NATIVE_UINT32, dims);
-    for (std::size_t i = 0; i + 2 < tri.size(); i += 3) {
-      const std::string what = "/final/mesh/triangles";
-      out.mesh.triangles.push_back(
-          {index(what, tri[i], i / 3), index(what, tri[i + 1], i / 3), index(what, tri[i + 2], i / 3)});
-    }
-    const auto ce = read_dataset<std::uint32_t>(file, "/final/mesh/constrained_edges", H5T_NATIVE_UINT32, dims);
-    for (std::size_t i = 0; i + 1 < ce.size(); i += 2) {
-      const std::string what = "/final/mesh/constrained_edges";
-      out.mesh.constrained_edges.push_back({index(what, ce[i], i / 2), index(what, ce[i + 1], i / 2)});
-    }
+    out.mesh.triangles = read_indices<3>(file, "/final/mesh/triangles", n);
+    out.mesh.constrained_edges = read_indices<2>(file, "/final/mesh/constrained_edges", n);
+    set_out_of_memory_context({});
   } catch (const InputError& e) {
     throw InputError("run file " + path.string() + ": " + e.what());
   } catch (const std::exception& e) {

@@ -15,6 +15,7 @@ namespace sb {
 
 namespace {
 
+using haptics::csv_check_time_order;
 using haptics::csv_fail;
 using haptics::csv_index;
 using haptics::csv_number;
@@ -71,9 +72,9 @@ ToolSpec read_tool(const CsvFile& f, const CsvTable& t, std::size_t r) {
   std::istringstream poly(t.rows[r][12]);
   std::vector<double> xy;
   for (std::string w; poly >> w;) {
-    char* end = nullptr;
-    const double v = std::strtod(w.c_str(), &end);
-    if (*end != '\0' || !std::isfinite(v)) csv_fail(f, line, "column polygon_m: '" + w + "' is not a number");
+    double v = 0.0;
+    if (!haptics::parse_decimal(w, v))
+      csv_fail(f, line, "column polygon_m: '" + w + "' is not a finite decimal number");
     xy.push_back(v);
   }
   if (xy.size() % 2 != 0) csv_fail(f, line, "column polygon_m must hold x y pairs");
@@ -127,6 +128,10 @@ void write_session(const std::filesystem::path& file, const Session& s) {
   });
 }
 
+namespace {
+Session session_from(const CsvFile& f, const std::string& option);
+}  // namespace
+
 Session read_session(const std::filesystem::path& file, const std::string& option) {
   // The CSV reader holds the whole file as text and cells: bound it before reading.
   std::error_code ec;
@@ -140,6 +145,22 @@ Session read_session(const std::filesystem::path& file, const std::string& optio
   } catch (const InputError& e) {
     throw InputError(option + " " + e.what());
   }
+  return session_from(f, option);
+}
+
+Session parse_session(const std::string& text, const std::string& name, const std::string& option) {
+  CsvFile f;
+  try {
+    f = haptics::parse_csv_tables(text, name);
+  } catch (const InputError& e) {
+    throw InputError(option + " " + e.what());
+  }
+  return session_from(f, option);
+}
+
+namespace {
+
+Session session_from(const CsvFile& f, const std::string& option) {
   try {
     Session s;
     for (const std::string& c : f.comments) {
@@ -156,17 +177,21 @@ Session read_session(const std::filesystem::path& file, const std::string& optio
     }
     if (f.find(haptics::kTrajectoryHeader)) s.trajectory = haptics::trajectory_from(f);
     if (const CsvTable* t = f.find(kForceHeader)) {
-      for (std::size_t r = 0; r < t->rows.size(); ++r)
+      for (std::size_t r = 0; r < t->rows.size(); ++r) {
         s.forces.push_back({csv_number(f, *t, r, 0),
                             {csv_number(f, *t, r, 1), csv_number(f, *t, r, 2), csv_number(f, *t, r, 3)},
                             csv_number(f, *t, r, 4),
                             {csv_number(f, *t, r, 5), csv_number(f, *t, r, 6), csv_number(f, *t, r, 7)}});
+        if (r > 0) csv_check_time_order(f, *t, r, 0, s.forces[r - 1].t_s, s.forces[r].t_s);
+      }
     } else if (const CsvTable* old = f.find(kForceHeaderWithoutModel)) {
-      for (std::size_t r = 0; r < old->rows.size(); ++r)
+      for (std::size_t r = 0; r < old->rows.size(); ++r) {
         s.forces.push_back({csv_number(f, *old, r, 0),
                             {csv_number(f, *old, r, 1), csv_number(f, *old, r, 2), csv_number(f, *old, r, 3)},
                             csv_number(f, *old, r, 4),
                             {0.0, 0.0, 0.0}});
+        if (r > 0) csv_check_time_order(f, *old, r, 0, s.forces[r - 1].t_s, s.forces[r].t_s);
+      }
     }
     const CsvTable* tools = f.find(kToolHeader);
     const CsvTable* stamps = f.find(kStampHeader);
@@ -182,7 +207,9 @@ Session read_session(const std::filesystem::path& file, const std::string& optio
                        std::to_string(kMaxSessionStamps) + ")");
     for (std::size_t r = 0; r < stamps->rows.size(); ++r) {
       SessionStamp st;
+      if (csv_index(f, *stamps, r, 0) != r) csv_fail(f, stamps->lines[r], "column stamp must count 0, 1, 2, ...");
       st.t_s = csv_number(f, *stamps, r, 1);
+      if (r > 0) csv_check_time_order(f, *stamps, r, 1, s.stamps.back().t_s, st.t_s);
       st.pose.xy = {csv_number(f, *stamps, r, 2), csv_number(f, *stamps, r, 3)};
       st.pose.bottom_z = csv_number(f, *stamps, r, 4);
       st.pose.heading_rad = csv_number(f, *stamps, r, 5);
@@ -206,7 +233,6 @@ Session read_session(const std::filesystem::path& file, const std::string& optio
   }
 }
 
-namespace {
 // A session tool as scene overrides: the keys the scene format has for its shape.
 std::vector<std::string> tool_overrides(const ToolSpec& t) {
   std::vector<std::string> o{unset_override("tool"), "tool.shape=\"" + to_string(t.shape) + "\""};

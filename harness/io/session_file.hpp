@@ -52,6 +52,8 @@ void write_session(const std::filesystem::path& file, const Session& session);
 // Throws InputError naming the file, line and column of anything malformed; `option` (e.g.
 // "--replay") prefixes the message.
 Session read_session(const std::filesystem::path& file, const std::string& option);
+// The same from the file's text (`name` for messages).
+Session parse_session(const std::string& text, const std::string& name, const std::string& option);
 
 // Bounds on what a session file may hold (a scene's stroke may have at most 1e7 stamps).
 inline constexpr std::size_t kMaxSessionStamps = 10000000;

@@ -79,19 +79,6 @@ std::string format_tick(double value, double step, bool plus) {
   return buf;
 }
 
-std::string format_bytes(double bytes) {
-  char buf[64];
-  if (bytes < 1024.0)
-    std::snprintf(buf, sizeof buf, "%.0f B", bytes);
-  else if (bytes < 1024.0 * 1024.0)
-    std::snprintf(buf, sizeof buf, "%.1f KiB", bytes / 1024.0);
-  else if (bytes < 1024.0 * 1024.0 * 1024.0)
-    std::snprintf(buf, sizeof buf, "%.2f MiB", bytes / (1024.0 * 1024.0));
-  else
-    std::snprintf(buf, sizeof buf, "%.2f GiB", bytes / (1024.0 * 1024.0 * 1024.0));
-  return buf;
-}
-
 std::string format_count(long long n) {
   std::string digits = std::to_string(n < 0 ? -n : n);
   std::string out;

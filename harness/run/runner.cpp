@@ -6,10 +6,13 @@
 #include <memory>
 #include <sstream>
 
+#include "common/input_error.hpp"
+
 namespace sb {
 
 PreparedScene prepare_scene(Scene scene) {
-  PreparedScene p{std::move(scene), {}, {}, {}, {}};
+  PreparedScene p;
+  p.scene = std::move(scene);
   p.initial = HeightField::from_scene(p.scene);
   // The lazy schedule outlives this function and copies of `p`: it keeps its own surface.
   auto surface = std::make_shared<const HeightField>(p.initial);
@@ -127,6 +130,16 @@ class StampWatch {
   double bed_ = 0.0, lowest_ = 0.0;
 };
 
+// Stops a model that grows past what its scene was estimated to need, before it takes the
+// machine's memory.
+void check_growth(const PreparedScene& p, std::size_t initial_vertices, const StepRecord& r) {
+  if (p.max_added_vertices == 0 || r.vertices <= initial_vertices + p.max_added_vertices) return;
+  throw InputError("the model grew to " + std::to_string(r.vertices) + " vertices (from " +
+                   std::to_string(initial_vertices) + "), past the " + std::to_string(p.max_added_vertices) +
+                   " it may add by the pre-flight's estimate (" + p.vertex_bound_reason + "); stopped at " +
+                   (r.stamp >= 0 ? "stamp " + std::to_string(r.stamp) : std::string("settling")) + ", nothing written");
+}
+
 }  // namespace
 
 RunResult run_schedule(Terrain& terrain, const PreparedScene& p, const RunCallbacks& cb) {
@@ -138,6 +151,7 @@ RunResult run_schedule(Terrain& terrain, const PreparedScene& p, const RunCallba
   run.volume_initial = terrain.volume();
   double volume = run.volume_initial;
   StampWatch watch(p, run.initial_raster);
+  const std::size_t initial_vertices = terrain.stats().vertices;
 
   const ErosionBudget step_budget{p.scene.erosion.max_passes_per_step};
   const std::size_t total = p.schedule.stamps.size();
@@ -162,6 +176,7 @@ RunResult run_schedule(Terrain& terrain, const PreparedScene& p, const RunCallba
     erode_and_simplify(terrain, p, step_budget, r, volume);
     r.volume_m3 = volume;
     record_model(r, terrain.stats());
+    check_growth(p, initial_vertices, r);
     run.memory_bytes_peak = std::max<std::size_t>(run.memory_bytes_peak, r.bytes);
     run.steps.push_back(r);
     // After about a second, a run that looks long says so once, whatever the terminal.
@@ -195,6 +210,7 @@ RunResult run_schedule(Terrain& terrain, const PreparedScene& p, const RunCallba
       passes_left -= passes;
       r.volume_m3 = volume;
       record_model(r, terrain.stats());
+      check_growth(p, initial_vertices, r);
       run.memory_bytes_peak = std::max<std::size_t>(run.memory_bytes_peak, r.bytes);
       run.steps.push_back(r);
       if (cb.notice && !announced && settling.seconds() > kSlowSettlingSeconds) {

@@ -5,6 +5,7 @@
 // outside the timers, only for back-ends that do not track it); volume() runs at the start
 // and the end, where the tracked total is checked against it (volume_tracking_error).
 // The final mesh is not copied: the run keeps the terrain, and writers stream its mesh.
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
@@ -27,6 +28,12 @@ struct PreparedScene {
   StampSchedule schedule;
   ErosionRule rule;
   Raster raster_template;  // the common sampling lattice (values zero)
+  // How many vertices the model may add to its initial count before the run stops with an
+  // InputError (0: no bound); what set the bound, named in that message.
+  std::size_t max_added_vertices = 0;
+  bool replay = false;                   // the schedule is a recorded session's, not the scene's stroke
+  std::uint64_t memory_limit_bytes = 0;  // what the pre-flight allowed (--max-memory or available); 0: unknown
+  std::string vertex_bound_reason;
 };
 PreparedScene prepare_scene(Scene scene);
 

@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "common/format_bytes.hpp"
 #include "common/input_error.hpp"
 #include "harness/run/backends.hpp"
+#include "harness/run/preflight.hpp"
 
 namespace sb {
 
@@ -68,16 +70,25 @@ std::string build_notice(const std::string& backend, const Scene& scene) {
   return text;
 }
 
-VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_progress) {
-  std::vector<std::string> overrides = base.scene.overrides;
+Scene variant_scene(const Variant& v, const Scene& base) {
+  if (v.overrides.empty()) return base;
+  std::vector<std::string> overrides = base.overrides;
   overrides.insert(overrides.end(), v.overrides.begin(), v.overrides.end());
-  Scene scene = base.scene;
-  if (!v.overrides.empty()) {
-    scene =
-        parse_scene(base.scene.text, base.scene.path, overrides, std::filesystem::path(base.scene.path).parent_path());
-  }
+  return parse_scene(base.text, base.path, overrides, std::filesystem::path(base.path).parent_path());
+}
+
+VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_progress) {
   PreparedScene prepared = base;
-  prepared.scene = scene;
+  prepared.scene = variant_scene(v, base.scene);
+  const Scene& scene = prepared.scene;
+  if (v.backend == "tin") {
+    prepared.max_added_vertices =
+        tin_vertex_allowance(scene, base.schedule.stamps.size(), base.replay, base.memory_limit_bytes);
+    prepared.vertex_bound_reason =
+        "8 x the vertices of tin.refine_m over the area the stroke disturbs, at most what " +
+        (base.memory_limit_bytes ? format_bytes(static_cast<double>(base.memory_limit_bytes)) : std::string("memory")) +
+        " holds";
+  }
   prepared.rule = ErosionRule::from(scene.material, scene.erosion.settle_tolerance_deg, scene.erosion.rule);
 
   if (const std::string notice = build_notice(v.backend, prepared.scene); !notice.empty())
@@ -93,10 +104,11 @@ VariantRun run_variant(const Variant& v, const PreparedScene& base, bool show_pr
   }
   VariantRun out{run_schedule(*terrain, prepared, callbacks), prepared, {}};
   out.run.label = v.label;
-  for (const std::string& w : out.run.warnings)
-    std::fprintf(stderr, "sandbench: warning: [%s] %s\n", v.label.c_str(), w.c_str());
   out.run.final_terrain = std::move(terrain);
   out.summary = summarize(out.run, prepared);
+  // The run's warnings and the summary's own (reference metrics that could not be computed).
+  for (const auto& w : out.summary["warnings"])
+    std::fprintf(stderr, "sandbench: warning: [%s] %s\n", v.label.c_str(), w.get<std::string>().c_str());
   return out;
 }
 

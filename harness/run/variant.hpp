@@ -24,8 +24,12 @@ struct Variant {
 // of the factory table.
 Variant parse_variant(const std::string& text, const std::string& option);
 
+// The variant's own scene: the base scene with its overrides applied (validated as a scene).
+Scene variant_scene(const Variant& v, const Scene& base);
+
 // Runs one variant on the prepared scene's schedule (variant overrides change back-end
-// parameters, never the stamps) and returns the run with its summary.
+// parameters, never the stamps) and returns the run with its summary. A TIN variant stops
+// (InputError) when it grows past the pre-flight's vertex allowance (tin_vertex_allowance).
 struct VariantRun {
   RunResult run;
   PreparedScene prepared;  // the variant's own scene, with the shared schedule
