@@ -93,7 +93,7 @@ TEST_F(DisplayRender, TilesLookAsTheWholeMesh) {
   };
   const Case cases[] = {
       {"", 0.5, 0.005},
-      {" --set 'domain.size_m=[1.0,1.0]' --set grid.cell_m=0.0025", 2.0, 0.03},
+      {" --set 'domain.size_m=[1.0,1.0]' --set grid.cell_m=0.0025", 3.0, 0.03},
   };
   for (const Case& c : cases) {
     Image images[2];
