@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -102,6 +103,28 @@ inline void stream_mesh(const SurfaceMesh& m, MeshSink& sink) {
   sink.constrained_edges(m.constrained_edges);
 }
 
+// Display change tracking (Terrain::lattice, changes_since, lattice_heights): a back-end whose
+// surface is a lattice of heights (the grids) tells which nodes changed since a version it gave,
+// so that a display keeping a copy reads only those.
+
+// Nodes [x0, x1) x [y0, y1) of a lattice.
+struct NodeRect {
+  std::size_t x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+// Node (ix, iy) lies at origin + (ix dx, iy dy).
+struct HeightLattice {
+  Vec2 origin{0.0, 0.0};
+  double dx = 1.0, dy = 1.0;
+  std::size_t nx = 0, ny = 0;
+};
+
+struct SurfaceChanges {
+  std::uint64_t version = 0;    // ask from this next time
+  bool tracked = false;         // false: not tracked, anything may have changed
+  std::vector<NodeRect> rects;  // tracked: every node changed since lies in one (none: nothing changed)
+};
+
 struct IntegrityReport {
   std::vector<std::string> problems;
   bool ok() const { return problems.empty(); }
@@ -125,6 +148,15 @@ class Terrain {
   virtual IntegrityReport check() const = 0;
   // Steepest slope between neighbours (the graph erosion uses), in degrees. O(model).
   virtual double max_slope_deg() const = 0;
+
+  // The surface's height lattice, if it is one (the grids; not the TIN).
+  virtual std::optional<HeightLattice> lattice() const { return std::nullopt; }
+  // What changed since `version`, a value an earlier call returned (0: the first call, which
+  // reports everything and may start the tracking). Default: not tracked.
+  virtual SurfaceChanges changes_since(std::uint64_t /*version*/) { return {}; }
+  // Lattice back-ends: the heights of the nodes of `r` minus z_ref, node (x, y) at
+  // out[(y - r.y0) * stride + (x - r.x0)]. O(nodes of r).
+  virtual void lattice_heights(const NodeRect& /*r*/, double /*z_ref*/, float* /*out*/, std::size_t /*stride*/) const {}
 };
 
 }  // namespace sb

@@ -66,14 +66,16 @@ BasicActiveSet<Idle>::BasicActiveSet(std::size_t nx, std::size_t ny, int idle_pa
       idle_passes_(static_cast<std::uint16_t>(idle_passes)),
       bits_(words_per_row_ * ny, 0),
       row_count_(ny, 0),
-      idle_(nx, ny, words_per_row_, idle_passes_) {
+      idle_(nx, ny, words_per_row_, idle_passes_),
+      changes_(words_per_row_, ny) {
   if (idle_passes < 1 || idle_passes > 32767)
     throw std::invalid_argument("ActiveSet: idle_passes must be in [1, 32767]");
 }
 
 template <class Idle>
 std::size_t BasicActiveSet<Idle>::bytes() const {
-  return bits_.capacity() * sizeof(std::uint64_t) + row_count_.capacity() * sizeof(std::uint32_t) + idle_.bytes();
+  return bits_.capacity() * sizeof(std::uint64_t) + row_count_.capacity() * sizeof(std::uint32_t) + idle_.bytes() +
+         changes_.bytes();
 }
 
 template <class Idle>

@@ -28,6 +28,8 @@
 #include <string>
 #include <vector>
 
+#include "grid/change_tiles.hpp"
+
 namespace sb::grid {
 
 // One idle count per node.
@@ -179,6 +181,7 @@ class BasicActiveSet {
           b = lo_bit + run >= 64 ? 0 : b & (~std::uint64_t{0} << (lo_bit + run));
         }
         word = d | kept;
+        if (d != 0) changes_.mark(y, w);
         count += static_cast<std::uint32_t>(bits_in_word(word));
       }
       size_ = size_ - row_count_[y] + count;
@@ -203,6 +206,10 @@ class BasicActiveSet {
   // nodes not reached stay members. Returns the number of visits.
   template <class Visit>
   std::size_t sweep(std::size_t max_visits, Visit&& visit);
+
+  // The tiles of the nodes that became members (with a fresh count) since a version: every
+  // height a grid writes is at such a node (change_tiles.hpp).
+  ChangeTiles& changes() { return changes_; }
 
   bool empty() const { return size_ == 0; }
   std::size_t size() const { return size_; }
@@ -238,6 +245,7 @@ class BasicActiveSet {
           (hi == 63 ? ~std::uint64_t{0} : (std::uint64_t{1} << (hi + 1)) - 1) & ~((std::uint64_t{1} << lo) - 1);
       const int added = bits_in(mask & ~row[wi]);
       row[wi] |= mask;
+      changes_.mark(y, wi);
       row_count_[y] += static_cast<std::uint32_t>(added);
       size_ += static_cast<std::size_t>(added);
       x += hi - lo + 1;
@@ -251,6 +259,7 @@ class BasicActiveSet {
   std::vector<std::uint64_t> bits_;       // membership, row-major, rows padded to words
   std::vector<std::uint32_t> row_count_;  // members per row
   Idle idle_;                             // consecutive idle visits of the members
+  ChangeTiles changes_;                   // tiles that gained members, for displays
 };
 
 template <class Idle>

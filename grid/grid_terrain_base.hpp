@@ -13,6 +13,7 @@
 // Costs: those stated in grid_terrain.hpp (dense) and sparse_terrain.hpp (sparse).
 // The member functions are defined here but instantiated only in grid_terrain.cpp and
 // sparse_terrain.cpp (extern template declarations next to each final class).
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -44,6 +45,10 @@ class GridTerrainBase : public Terrain {
   SurfaceMesh mesh() const override { return grid_mesh(heights_); }
   void sample(Raster& out) const override { grid_sample(heights_, out); }
   double max_slope_deg() const override { return grid_max_slope_deg(heights_, stencil_); }
+  std::optional<HeightLattice> lattice() const override;
+  // The 64 x 64 node tiles the active set marked (change_tiles.hpp). O(tiles).
+  SurfaceChanges changes_since(std::uint64_t version) override;
+  void lattice_heights(const NodeRect& r, double z_ref, float* out, std::size_t stride) const override;
 
   // For tests and benchmarks: every node a member of the active set, or node (ix, iy) and its
   // 3 x 3 block (as a stamp activates the nodes it changed); which sweep erosion runs
@@ -109,6 +114,35 @@ ErosionReport GridTerrainBase<Heights, Active>::erode(const ErosionRule& rule, c
   // Transfers conserve volume; only rounding into the carry changes the stored volume.
   report.volume_change_m3 = carry_before - heights_.carry_m3();
   return report;
+}
+
+template <class Heights, class Active>
+std::optional<HeightLattice> GridTerrainBase<Heights, Active>::lattice() const {
+  const GridLayout& l = heights_.layout();
+  return HeightLattice{l.origin, l.dx, l.dy, l.nx, l.ny};
+}
+
+template <class Heights, class Active>
+SurfaceChanges GridTerrainBase<Heights, Active>::changes_since(std::uint64_t version) {
+  std::vector<std::uint32_t> tiles;
+  ChangeTiles& changes = active_.changes();
+  SurfaceChanges c{.version = changes.since(version, tiles), .tracked = true, .rects = {}};
+  const GridLayout& l = heights_.layout();
+  constexpr std::size_t side = ChangeTiles::kSide;
+  c.rects.reserve(tiles.size());
+  for (const std::uint32_t t : tiles) {
+    const std::size_t x0 = (t % changes.cols()) * side, y0 = (t / changes.cols()) * side;
+    c.rects.push_back({x0, y0, std::min(l.nx, x0 + side), std::min(l.ny, y0 + side)});
+  }
+  return c;
+}
+
+template <class Heights, class Active>
+void GridTerrainBase<Heights, Active>::lattice_heights(const NodeRect& r, double z_ref, float* out,
+                                                       std::size_t stride) const {
+  for (std::size_t y = r.y0; y < r.y1; ++y)
+    for (std::size_t x = r.x0; x < r.x1; ++x)
+      out[(y - r.y0) * stride + (x - r.x0)] = static_cast<float>(heights_.z(x, y) - z_ref);
 }
 
 template <class Heights, class Active>

@@ -1,6 +1,7 @@
 #include "harness/interactive/sim.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 
@@ -11,11 +12,16 @@ namespace sb {
 
 namespace {
 
-constexpr double kMinPenetration_m = 1e-4;  // shallower contact does not stamp
-constexpr double kDisplayPeriod_s = 1.0 / 30.0;
+constexpr double kMinPenetration_m = 1e-4;       // shallower contact does not stamp
+constexpr double kDisplayPeriod_s = 1.0 / 30.0;  // counters, and a whole mesh
+constexpr double kTilePeriod_s = 1.0 / 60.0;     // a lattice's changed tiles
 constexpr std::size_t kRecentSteps = 256;
 
 double patch_margin(double reach_m) { return std::max(0.015, 0.5 * reach_m); }
+
+double steady_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
 
 std::string material_override(const char* key, double v) {
   return "material." + std::string(key) + "=" + exact_number(v);
@@ -24,7 +30,7 @@ std::string material_override(const char* key, double v) {
 }  // namespace
 
 Simulation::Simulation(const PreparedScene& prepared, std::unique_ptr<Terrain> terrain, haptics::PatchBuffer& patches,
-                       haptics::ServoLoop& servo, std::string backend)
+                       haptics::ServoLoop& servo, std::string backend, bool tiles)
     : prepared_(prepared),
       terrain_(std::move(terrain)),
       patches_(patches),
@@ -41,6 +47,9 @@ Simulation::Simulation(const PreparedScene& prepared, std::unique_ptr<Terrain> t
   recent_ms_.assign(kRecentSteps, 0.0);
   totals_.volume_initial_m3 = terrain_->volume();
   status_.volume_initial_m3 = totals_.volume_initial_m3;
+  volume_m3_ = totals_.volume_initial_m3;
+  const Aabb2 box = prepared.scene.domain.box();
+  feed_ = std::make_unique<DisplayFeed>(*terrain_, prepared.initial(0.5 * (box.lo + box.hi)), tiles);
   publish_patch(prepared.scene.domain.box().lo + 0.5 * prepared.scene.domain.size_m);
   publish_display(true);
 }
@@ -59,8 +68,10 @@ void Simulation::stop() {
   thread_.join();
   record_request_.store(0);
   if (recording_) end_recording();
+  publish_display(true);  // the final surface, for a window that draws once more
   totals_.final_stats = terrain_->stats();
   totals_.volume_final_m3 = terrain_->volume();
+  totals_.volume_tracked_m3 = volume_m3_;
 }
 
 SimControls Simulation::controls() const {
@@ -79,11 +90,6 @@ void Simulation::set_controls(const SimControls& c) {
 SimStatus Simulation::status() const {
   std::lock_guard lock(mutex_);
   return status_;
-}
-
-std::shared_ptr<const DisplayMesh> Simulation::mesh() const {
-  std::lock_guard lock(mutex_);
-  return mesh_;
 }
 
 void Simulation::start_recording(const std::filesystem::path& file) {
@@ -143,6 +149,7 @@ void Simulation::step() {
       const ErosionReport er = terrain_->erode(rule_, ErosionBudget{active_.erosion_passes, active_.erosion_updates,
                                                                     !stamped, prepared_.scene.erosion.cascade});
       erosion_ms = 1e3 * sw.seconds();
+      add_volume(er.volume_change_m3);
       active_set_ = er.active;
       changed |= er.transfers > 0;
     }
@@ -150,6 +157,7 @@ void Simulation::step() {
       sw.restart();
       const SimplifyReport sr = terrain_->simplify(SimplifyParams{prepared_.scene.tin.alpha_flat_deg});
       simplify_ms = 1e3 * sw.seconds();
+      add_volume(sr.volume_change_m3);
       changed |= sr.removed > 0;
     }
     changed |= stamped;
@@ -211,7 +219,8 @@ bool Simulation::maybe_stamp(const haptics::ServoState& s) {
   pose.bottom_z = p.z();
   pose.heading_rad = tool.shape == ToolShape::Pour ? 0.0 : heading_rad_;
   const ToolStamp stamp = make_stamp(tool, pose, dir, generation_++);
-  terrain_->stamp(stamp);
+  add_volume(terrain_->stamp(stamp).volume_change_m3);
+  stamp_times_s_.push_back(steady_seconds());
   if (stamp.is_pour()) totals_.volume_added_m3 += stamp.pour_volume_m3;
   ++totals_.stamps;
   have_stamp_ = true;
@@ -235,22 +244,31 @@ void Simulation::publish_patch(const Vec2& centre) {
   status_.patch_ms = ms;
 }
 
+void Simulation::add_volume(double change_m3) {
+  // A back-end that does not track a phase's change (NaN) is measured instead.
+  if (std::isnan(change_m3)) {
+    volume_m3_ = terrain_->volume();
+  } else {
+    volume_m3_ += change_m3;
+  }
+}
+
 void Simulation::publish_display(bool force) {
   const double now = clock_.seconds();
-  if (!force && !(dirty_ && now - last_display_s_ >= kDisplayPeriod_s) && now - last_display_s_ < 1.0) return;
-  auto mesh = std::make_shared<DisplayMesh>();
-  if (dirty_ || force || !mesh_) {
-    mesh->mesh = terrain_->mesh();
-    mesh->version = patch_version_;
+  const double period = feed_->lattice() ? kTilePeriod_s : kDisplayPeriod_s;
+  if (force || (dirty_ && now - last_surface_s_ >= period)) {
+    Stopwatch sw;
+    if (feed_->publish(*terrain_, dirty_ || force, stamp_times_s_)) totals_.display_ms.push_back(1e3 * sw.seconds());
+    dirty_ = false;
+    last_surface_s_ = now;
   }
+  if (!force && now - last_status_s_ < kDisplayPeriod_s) return;
   const ModelStats stats = terrain_->stats();
-  const double volume = terrain_->volume();
   std::vector<double> recent(recent_ms_.begin(), recent_ms_.begin() + std::min(recent_next_, kRecentSteps));
   const double p50 = percentile(recent, 0.5), p95 = percentile(recent, 0.95);
   std::lock_guard lock(mutex_);
-  if (dirty_ || force || !mesh_) mesh_ = std::move(mesh);
   status_.stats = stats;
-  status_.volume_m3 = volume;
+  status_.volume_m3 = volume_m3_;
   status_.volume_added_m3 = totals_.volume_added_m3;
   status_.steps = totals_.steps;
   status_.stamps = totals_.stamps;
@@ -261,8 +279,7 @@ void Simulation::publish_display(bool force) {
   status_.tool_heading_rad = heading_rad_;
   status_.recorded_samples = session_.trajectory.samples.size();
   status_.recorded_stamps = session_.stamps.size();
-  dirty_ = false;
-  last_display_s_ = now;
+  last_status_s_ = now;
 }
 
 void Simulation::drain_samples() {

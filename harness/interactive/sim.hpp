@@ -2,10 +2,13 @@
 // The interactive simulation thread. It owns the terrain (nobody else touches it) and loops:
 // read the servo's newest state; stamp when the tool penetrates the sand and has moved at
 // least the stroke spacing (or gone deeper) since the last stamp; erode within a per-step
-// budget; simplify; republish the height patch for the servo; every 1/30 s hand a mesh and
-// counters to the window. Controls from the window and the display snapshot go through a
-// mutex that the servo never sees. Optionally records the session (device samples drained
-// from the servo's queue, every stamp applied).
+// budget; simplify; republish the height patch for the servo; hand what changed of the surface
+// to the window's DisplayFeed (display_feed.hpp: the changed tiles of a grid up to 60 times a
+// second, a whole mesh of a TIN up to 30) and every 1/30 s the counters. Nothing per display
+// update costs the size of the terrain: the volume shown is kept from the phases' reported
+// changes, as the runner does. Controls from the window and the counters go through a mutex
+// that the servo never sees. Optionally records the session (device samples drained from the
+// servo's queue, every stamp applied).
 #include <atomic>
 #include <filesystem>
 #include <memory>
@@ -15,6 +18,7 @@
 #include <vector>
 
 #include "common/haptics/servo_loop.hpp"
+#include "harness/interactive/display_feed.hpp"
 #include "harness/io/session_file.hpp"
 #include "harness/run/runner.hpp"
 
@@ -46,33 +50,31 @@ struct SimStatus {
 // Whole-run figures for the statistics file.
 struct SimTotals {
   std::uint64_t steps = 0, stamps = 0, patches = 0;
-  std::vector<double> step_ms;   // every working step: stamp + erode + simplify
-  std::vector<double> patch_ms;  // every publication
+  std::vector<double> step_ms;     // every working step: stamp + erode + simplify
+  std::vector<double> patch_ms;    // every publication
+  std::vector<double> display_ms;  // every surface publication to the window (DisplayFeed::publish)
   ModelStats final_stats;
   double volume_initial_m3 = 0.0, volume_final_m3 = 0.0, volume_added_m3 = 0.0;
-};
-
-struct DisplayMesh {
-  std::uint64_t version = 0;
-  SurfaceMesh mesh;
+  double volume_tracked_m3 = 0.0;  // initial plus the phases' reported changes (what the panel showed)
 };
 
 class Simulation {
  public:
-  // Publishes a first patch (at the domain's centre) and a first mesh before returning, so the
-  // servo and the window have something from their first tick and frame.
+  // Publishes a first patch (at the domain's centre) and the whole surface before returning, so
+  // the servo and the window have something from their first tick and frame.
+  // tiles: a lattice back-end's display is fed by its changed tiles (false: by whole meshes).
   Simulation(const PreparedScene& prepared, std::unique_ptr<Terrain> terrain, haptics::PatchBuffer& patches,
-             haptics::ServoLoop& servo, std::string backend);
+             haptics::ServoLoop& servo, std::string backend, bool tiles = true);
   ~Simulation();
 
   void start();
-  void stop();  // joins, then finishes a recording in progress (writes its file)
+  void stop();  // joins, finishes a recording in progress (writes its file), publishes the final surface
 
   // Window thread.
   SimControls controls() const;
   void set_controls(const SimControls& c);
   SimStatus status() const;
-  std::shared_ptr<const DisplayMesh> mesh() const;
+  DisplayFeed& display() { return *feed_; }
   // Recording into `file` (written when stopped, whole or not at all).
   void start_recording(const std::filesystem::path& file);
   void stop_recording();
@@ -88,6 +90,7 @@ class Simulation {
   bool maybe_stamp(const haptics::ServoState& s);
   void publish_patch(const Vec2& centre);
   void publish_display(bool force);
+  void add_volume(double change_m3);
   void drain_samples();
   void begin_recording();
   void end_recording();
@@ -109,9 +112,12 @@ class Simulation {
   Vec2 last_stamp_xy_{0.0, 0.0};
   double last_stamp_z_ = 0.0, last_stamp_t_ = 0.0, heading_rad_ = 0.0;
   std::uint32_t generation_ = 0;
-  bool dirty_ = false;          // terrain changed since the last display snapshot
+  bool dirty_ = false;          // terrain changed since the last surface publication
   std::size_t active_set_ = 1;  // erosion active set after the last erode (1: unknown)
-  double last_display_s_ = -1.0;
+  double last_surface_s_ = -1.0, last_status_s_ = -1.0;
+  double volume_m3_ = 0.0;             // initial volume plus every phase's reported change
+  std::vector<double> stamp_times_s_;  // steady-clock times of stamps not yet published
+  std::unique_ptr<DisplayFeed> feed_;
   std::vector<double> recent_ms_;  // ring of the last working steps
   std::size_t recent_next_ = 0;
   SimTotals totals_;
@@ -128,7 +134,6 @@ class Simulation {
   mutable std::mutex mutex_;  // guards the members below (never taken by the servo)
   SimControls controls_;
   SimStatus status_;
-  std::shared_ptr<const DisplayMesh> mesh_;
   std::filesystem::path requested_file_;
   std::string record_error_;
 };

@@ -68,8 +68,20 @@ Json haptic_stats_json(const haptics::ServoStats& s, const haptics::DeviceLimits
   j["volume_initial"] = sim.volume_initial_m3;
   j["volume_final"] = sim.volume_final_m3;
   j["volume_added"] = sim.volume_added_m3;
+  j["volume_tracked"] = sim.volume_tracked_m3;
   j["frames"] = info.frames;
   j["fps"] = info.wall_s > 0.0 ? static_cast<double>(info.frames) / info.wall_s : 0.0;
+  // The display path: frame times, the simulation's publication of the surface's changes, the
+  // window's uploads, and how long a stamp takes to show.
+  j["frame_ms.p50"] = percentile(info.frame_ms, 0.5);
+  j["frame_ms.p99"] = percentile(info.frame_ms, 0.99);
+  j["display_updates"] = sim.display_ms.size();
+  j["display_ms.p50"] = percentile(sim.display_ms, 0.5);
+  j["display_ms.p95"] = percentile(sim.display_ms, 0.95);
+  j["upload_ms.p50"] = percentile(info.upload_ms, 0.5);
+  j["upload_ms.p95"] = percentile(info.upload_ms, 0.95);
+  j["stamp_to_frame_ms.p50"] = percentile(info.stamp_to_frame_ms, 0.5);
+  j["stamp_to_frame_ms.p95"] = percentile(info.stamp_to_frame_ms, 0.95);
   j["backend"] = info.backend;
   j["device"] = info.device;
   j["scene"] = info.scene;

@@ -4,6 +4,7 @@
 // force_max_n) first, then the limits, the simulation's figures and bookkeeping.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "common/haptics/servo_loop.hpp"
 #include "harness/interactive/sim.hpp"
@@ -14,8 +15,11 @@ namespace sb {
 struct InteractiveRunInfo {
   std::string scene, backend, device;
   std::uint64_t frames = 0;
-  double wall_s = 0.0;               // window open time
-  double device_force_max_n = -1.0;  // as the device saw it (replay, mouse); < 0: unknown
+  double wall_s = 0.0;                    // window open time
+  double device_force_max_n = -1.0;       // as the device saw it (replay, mouse); < 0: unknown
+  std::vector<double> frame_ms;           // every frame: swap to swap
+  std::vector<double> upload_ms;          // every surface upload the window made
+  std::vector<double> stamp_to_frame_ms;  // every stamp: applied to the swap of the first frame showing it
 };
 
 Json haptic_stats_json(const haptics::ServoStats& servo, const haptics::DeviceLimits& limits, const SimTotals& sim,

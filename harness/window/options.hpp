@@ -19,6 +19,7 @@ struct InteractiveOptions {
   double rate_hz = 1000.0;
   double spin_us = 150.0;
   bool realtime = true;
+  bool mesh_display = false;  // grids drawn as a whole mesh, as the TIN (for comparison)
   int width = 1280, height = 800;
 };
 

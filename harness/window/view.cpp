@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "harness/window/gl_program.hpp"
+
 namespace sb {
 
 namespace {
@@ -17,25 +19,6 @@ out vec3 world;
 void main() {
   world = position;
   gl_Position = view_projection * vec4(position, 1.0);
-})";
-
-// Facet normals from screen-space derivatives: every triangle shows as it is.
-constexpr const char* kSurfaceFs = R"(#version 330 core
-in vec3 world;
-uniform vec2 z_range;
-uniform vec4 tint;
-uniform vec3 light;  // the renderer's light and weights (render/camera.hpp)
-uniform vec2 ambient_diffuse;
-out vec4 colour;
-void main() {
-  if (tint.a > 0.0) { colour = tint; return; }
-  vec3 n = normalize(cross(dFdx(world), dFdy(world)));
-  if (n.z < 0.0) n = -n;
-  float h = clamp((world.z - z_range.x) / max(z_range.y - z_range.x, 1e-6), 0.0, 1.0);
-  vec3 low = vec3(0.55, 0.42, 0.26), high = vec3(0.93, 0.82, 0.60);
-  vec3 base = mix(low, high, h);
-  float diffuse = max(dot(n, light), 0.0);
-  colour = vec4(base * (ambient_diffuse.x + ambient_diffuse.y * diffuse), 1.0);
 })";
 
 constexpr const char* kLineVs = R"(#version 330 core
@@ -53,43 +36,11 @@ in vec3 c;
 out vec4 colour;
 void main() { colour = vec4(c, 1.0); })";
 
-unsigned compile(GLenum type, const char* source) {
-  const unsigned s = glCreateShader(type);
-  glShaderSource(s, 1, &source, nullptr);
-  glCompileShader(s);
-  GLint ok = 0;
-  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[2048];
-    glGetShaderInfoLog(s, sizeof log, nullptr, log);
-    throw std::runtime_error(std::string("OpenGL shader: ") + log);
-  }
-  return s;
-}
-
-unsigned link(const char* vs, const char* fs) {
-  const unsigned v = compile(GL_VERTEX_SHADER, vs), f = compile(GL_FRAGMENT_SHADER, fs);
-  const unsigned p = glCreateProgram();
-  glAttachShader(p, v);
-  glAttachShader(p, f);
-  glLinkProgram(p);
-  glDeleteShader(v);
-  glDeleteShader(f);
-  GLint ok = 0;
-  glGetProgramiv(p, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[2048];
-    glGetProgramInfoLog(p, sizeof log, nullptr, log);
-    throw std::runtime_error(std::string("OpenGL program: ") + log);
-  }
-  return p;
-}
-
 }  // namespace
 
 TerrainView::TerrainView(const Vec3& origin, double z_lo, double z_hi) : origin_(origin), z_lo_(z_lo), z_hi_(z_hi) {
-  surface_program_ = link(kSurfaceVs, kSurfaceFs);
-  line_program_ = link(kLineVs, kLineFs);
+  surface_program_ = link_program(kSurfaceVs, kSurfaceFragmentShader);
+  line_program_ = link_program(kLineVs, kLineFs);
   glGenVertexArrays(1, &mesh_vao_);
   glGenBuffers(1, &mesh_vbo_);
   glGenBuffers(1, &mesh_ebo_);
@@ -110,6 +61,7 @@ TerrainView::TerrainView(const Vec3& origin, double z_lo, double z_hi) : origin_
 }
 
 TerrainView::~TerrainView() {
+  lattice_.reset();
   glDeleteBuffers(1, &mesh_vbo_);
   glDeleteBuffers(1, &mesh_ebo_);
   glDeleteBuffers(1, &line_vbo_);
@@ -135,8 +87,16 @@ void TerrainView::upload_mesh(const SurfaceMesh& mesh) {
   mesh_indices_ = static_cast<int>(mesh.triangles.size() * 3);
 }
 
+void TerrainView::use_lattice(const HeightLattice& lattice, double z_ref) {
+  lattice_ = std::make_unique<LatticeSurface>(lattice, origin_, z_ref);
+}
+
+void TerrainView::upload_lattice(const LatticeUpdate& update) {
+  if (lattice_) lattice_->upload(update);
+}
+
 void TerrainView::draw(const Camera& camera, int width, int height, bool wireframe,
-                       const std::vector<LineVertex>& lines) {
+                       const std::vector<LineVertex>& lines, const Vec2& focus) {
   glViewport(0, 0, width, height);
   glClearColor(0.16f, 0.18f, 0.22f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
@@ -144,26 +104,34 @@ void TerrainView::draw(const Camera& camera, int width, int height, bool wirefra
   glDepthFunc(GL_LEQUAL);
   const Eigen::Matrix4f vp = camera.view_projection(static_cast<double>(width) / std::max(height, 1), origin_);
 
-  glUseProgram(surface_program_);
-  glUniformMatrix4fv(glGetUniformLocation(surface_program_, "view_projection"), 1, GL_FALSE, vp.data());
-  glUniform2f(glGetUniformLocation(surface_program_, "z_range"), static_cast<float>(z_lo_ - origin_.z()),
+  const unsigned program = lattice_ ? lattice_->program() : surface_program_;
+  glUseProgram(program);
+  glUniformMatrix4fv(glGetUniformLocation(program, "view_projection"), 1, GL_FALSE, vp.data());
+  glUniform2f(glGetUniformLocation(program, "z_range"), static_cast<float>(z_lo_ - origin_.z()),
               static_cast<float>(z_hi_ - origin_.z()));
   const Vec3 light = light_direction();
-  glUniform3f(glGetUniformLocation(surface_program_, "light"), static_cast<float>(light.x()),
-              static_cast<float>(light.y()), static_cast<float>(light.z()));
-  glUniform2f(glGetUniformLocation(surface_program_, "ambient_diffuse"), static_cast<float>(kAmbient),
+  glUniform3f(glGetUniformLocation(program, "light"), static_cast<float>(light.x()), static_cast<float>(light.y()),
+              static_cast<float>(light.z()));
+  glUniform2f(glGetUniformLocation(program, "ambient_diffuse"), static_cast<float>(kAmbient),
               static_cast<float>(kDiffuse));
-  const int tint = glGetUniformLocation(surface_program_, "tint");
-  glBindVertexArray(mesh_vao_);
+  const int tint = glGetUniformLocation(program, "tint");
+  const auto surface = [&] {
+    if (lattice_) {
+      lattice_->draw(focus);
+    } else {
+      glBindVertexArray(mesh_vao_);
+      glDrawElements(GL_TRIANGLES, mesh_indices_, GL_UNSIGNED_INT, nullptr);
+    }
+  };
   glEnable(GL_POLYGON_OFFSET_FILL);
   glPolygonOffset(1.0f, 1.0f);
   glUniform4f(tint, 0, 0, 0, 0);
-  glDrawElements(GL_TRIANGLES, mesh_indices_, GL_UNSIGNED_INT, nullptr);
+  surface();
   glDisable(GL_POLYGON_OFFSET_FILL);
   if (wireframe) {
     glPolygonMode(GL_FRONT_AND_BACK, GL_LINE);
     glUniform4f(tint, 0.25f, 0.2f, 0.12f, 1.0f);
-    glDrawElements(GL_TRIANGLES, mesh_indices_, GL_UNSIGNED_INT, nullptr);
+    surface();
     glPolygonMode(GL_FRONT_AND_BACK, GL_FILL);
   }
 

@@ -1,12 +1,16 @@
 #pragma once
-// The interactive window's 3-D drawing, plain OpenGL 3.3 core through libepoxy: the terrain mesh (flat-shaded
-// facets, coloured by height, optional wireframe) and coloured line overlays (the tool, the
-// force arrow). Uploading a mesh is O(vertices + triangles); drawing is one call per layer.
+// The interactive window's 3-D drawing, plain OpenGL 3.3 core through libepoxy: the terrain
+// (flat-shaded facets, coloured by height, optional wireframe) and coloured line overlays (the
+// tool, the force arrow). The terrain is a mesh (uploading one is O(vertices + triangles)) or,
+// for a height lattice, a LatticeSurface (lattice_view.hpp: uploads per changed tile, triangles
+// bounded by its levels of detail around the tool); both share one fragment shader.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "common/terrain.hpp"
 #include "harness/render/camera.hpp"
+#include "harness/window/lattice_view.hpp"
 
 namespace sb {
 
@@ -24,8 +28,13 @@ class TerrainView {
   TerrainView& operator=(const TerrainView&) = delete;
 
   void upload_mesh(const SurfaceMesh& mesh);
-  // Clears and draws the terrain and the lines for a width x height framebuffer.
-  void draw(const Camera& camera, int width, int height, bool wireframe, const std::vector<LineVertex>& lines);
+  // From now on the terrain is this lattice, drawn from its heights (DisplayFeed's z_ref).
+  void use_lattice(const HeightLattice& lattice, double z_ref);
+  void upload_lattice(const LatticeUpdate& update);
+  // Clears and draws the terrain and the lines for a width x height framebuffer; a lattice is
+  // drawn at full resolution around `focus` (world x, y: the tool).
+  void draw(const Camera& camera, int width, int height, bool wireframe, const std::vector<LineVertex>& lines,
+            const Vec2& focus);
   // The framebuffer's back buffer as RGB rows, top row first.
   std::vector<std::uint8_t> read_pixels(int width, int height) const;
 
@@ -36,6 +45,7 @@ class TerrainView {
   unsigned mesh_vao_ = 0, mesh_vbo_ = 0, mesh_ebo_ = 0;
   unsigned line_vao_ = 0, line_vbo_ = 0;
   int mesh_indices_ = 0;
+  std::unique_ptr<LatticeSurface> lattice_;
 };
 
 }  // namespace sb

@@ -31,12 +31,8 @@ using Result = test::CliResult;
 // `cmd` in the shell, its stdout and stderr together.
 Result shell(const std::string& cmd) { return test::run_shell("{ " + cmd + "; } 2>&1"); }
 
-bool have_xvfb() { return shell("command -v xvfb-run").code == 0; }
-
-// Under AddressSanitizer, the GL and X libraries' own allocations at exit are not ours.
-std::string xvfb() {
-  return "ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 xvfb-run -a -s '-screen 0 1024x768x24' ";
-}
+using test::have_xvfb;
+using test::xvfb;
 
 std::string scene_path() { return test::shipped_scene("flat_stroke.toml"); }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Test support for the harness tests: shell commands and the sandbench binary run as
-// processes, the shipped scenes, whole files, and a fixture with its own temporary folder.
+// processes (in a window under Xvfb too), the shipped scenes, whole files, and a fixture with
+// its own temporary folder.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -36,6 +37,15 @@ inline CliResult run_shell(const std::string& command) {
 // and exit code.
 inline CliResult sandbench(const std::string& args) {
   return run_shell(std::string(SB_CLI_PATH) + " " + args + " 2>&1");
+}
+
+// Whether xvfb-run is installed (windows under a virtual display).
+inline bool have_xvfb() { return run_shell("command -v xvfb-run >/dev/null 2>&1").code == 0; }
+
+// The prefix that runs a command in a window under Xvfb. Under AddressSanitizer, the GL and X
+// libraries' own allocations at exit are not ours.
+inline std::string xvfb() {
+  return "ASAN_OPTIONS=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 xvfb-run -a -s '-screen 0 1024x768x24' ";
 }
 
 // The path of a scene shipped in experiments/scenes, e.g. "flat_stroke.toml".
