@@ -140,6 +140,7 @@ def section_figure(ctx, cases, names):
         ax.set_xlabel("across the stroke, mm")
         ax.set_ylabel("height above the bed, mm")
         ax.legend(fontsize=7)
+    fig.tight_layout()
     return ctx.figure(fig, "particles_sections")
 
 
@@ -352,9 +353,9 @@ def values(cases, table, figures, other):
                                      "other far better than with the grains" if shared else
                                      "partly the discretisation: the back-ends differ from each other by a sizeable "
                                      "part of their distance from the grains")})
-            for b in BACKENDS:
-                summary.setdefault(b, {})["accuracy vs particle sand"] = \
-                    f"{c['case']}: {rmse[b] * 1e3:.1f} mm section RMSE"
+            for b in BACKENDS:  # the report's summary table joins the cases' cells
+                summary.setdefault(b, {}).setdefault("accuracy vs particle sand", [])
+                summary[b]["accuracy vs particle sand"].append(f"{c['case']} {rmse[b] * 1e3:.1f} mm")
         else:
             flank, flank_sd = spread([s["flank_deg"] for s in c["dem_seeds"]])
             item.update({"flank_deg": {b: c["backends"][b]["flank_deg"] for b in BACKENDS},
@@ -363,6 +364,7 @@ def values(cases, table, figures, other):
                          "calibration": "within 1 degree" if abs(flank - c["critical"]) <= 1.0 else
                          "more than 1 degree off"})
         out_cases.append(item)
+    summary = {b: {col: "section RMSE " + ", ".join(cells) for col, cells in cols.items()} for b, cols in summary.items()}
     return {"cases": out_cases, "table": table, "figures": figures, "summary": summary}
 
 
