@@ -31,9 +31,8 @@ def _string(group, name, text):
 def write(path, name, case, material_path, sides, folders):
     """Writes the reference of case NAME from its seeds' sidecars and result folders, whole or not
     at all (a temporary file renamed)."""
-    from run_dem import ROOT
-    import surface
     import tomllib
+    from run_dem import ROOT
     material = tomllib.loads(Path(material_path).read_text())
     scene = tomllib.loads((ROOT / case["scene"]).read_text())
     origin = scene.get("domain", {}).get("origin_m", [0.0, 0.0])
@@ -68,7 +67,6 @@ def write(path, name, case, material_path, sides, folders):
                                          ("stages", "grains", "grain_volume_m3", "bed_offset_m", "finished")}
                                          for s in sides})
     tmp.replace(path)
-    del surface
     return path
 
 

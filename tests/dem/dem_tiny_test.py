@@ -8,7 +8,6 @@ tool's force reduced and written to a reference file, which is read back and che
   surface has a cut below the bed along the path;
 - a second start finds the run done and runs nothing.
 Usage: dem_tiny_test.py (LAMMPS's `lmp` on PATH; the test is skipped, exit 77, without it)."""
-import math
 import shutil
 import subprocess
 import sys
