@@ -196,7 +196,12 @@ def main():
     ap.add_argument("--poll", type=float, default=5.0)
     args = ap.parse_args()
     material_path = Path(args.material)
-    all_cases = load_toml(args.cases_file)
+    try:
+        all_cases = load_toml(args.cases_file)
+        load_toml(material_path)
+    except (OSError, tomllib.TOMLDecodeError) as e:
+        sys.stderr.write(f"run_dem: {e}\n")
+        return 2
     args.cases = args.cases or list(all_cases)
     unknown = [c for c in args.cases if c not in all_cases]
     if unknown:
@@ -204,6 +209,12 @@ def main():
                          f"(it has {', '.join(all_cases)})\n")
         return 2
     args.seeds = args.seeds or load_toml(material_path)["reference"]["seeds"]
+    for name in args.cases:  # every case's scene checked before any run starts
+        try:
+            lammps_input.Geometry(load_toml(ROOT / all_cases[name]["scene"]), load_toml(material_path))
+        except (lammps_input.SceneError, OSError, KeyError, tomllib.TOMLDecodeError) as e:
+            sys.stderr.write(f"run_dem: case {name} ({all_cases[name].get('scene', 'no scene')}): {e}\n")
+            return 2
     if shutil.which(args.lmp) is None:
         sys.stderr.write(f"run_dem: `{args.lmp}` not found: the references need LAMMPS (Debian: lammps); "
                          f"`make reproduce` reads the stored ones and does not\n")

@@ -6,7 +6,8 @@ tool's force reduced and written to a reference file, which is read back and che
 - the grains conserved (the same count and grain volume before, with the tool in, and after);
 - the tool met the sand: it was pushed back against its motion while it cut, and the final
   surface has a cut below the bed along the path;
-- a second start finds the run done and runs nothing.
+- a second start finds the run done and runs nothing;
+- a scene it cannot model is refused up front (exit 2, naming the key).
 Usage: dem_tiny_test.py (LAMMPS's `lmp` on PATH; the test is skipped, exit 77, without it)."""
 import shutil
 import subprocess
@@ -30,7 +31,20 @@ def check(cond, message):
     print(f"ok: {message}")
 
 
+def refuses_what_it_cannot_model(tmp):
+    """A scene the particles cannot model (dunes) is refused before any run: exit 2, the key named,
+    nothing written."""
+    cases = Path(tmp) / "bad_cases.toml"
+    cases.write_text('[bad]\nscene = "experiments/scenes/dunes.toml"\nspeed_m_per_s = 0.1\n')
+    proc = subprocess.run(RUN_DEM[:2] + ["--cases-file", str(cases), "--work", f"{tmp}/bad-work", "--out",
+                                         f"{tmp}/bad-ref"], capture_output=True, text=True, timeout=120)
+    check(proc.returncode == 2 and "terrain.kind" in proc.stderr and not Path(tmp, "bad-ref").exists(),
+          f"an unsupported scene is refused naming terrain.kind ({proc.stderr.strip()})")
+
+
 def main():
+    with tempfile.TemporaryDirectory() as tmp:
+        refuses_what_it_cannot_model(tmp)
     if shutil.which("lmp") is None:
         print("lmp not found: skipped (Debian: lammps, installed by .ci/deps.sh)")
         return 77
