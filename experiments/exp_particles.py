@@ -76,7 +76,7 @@ def raster_of(path, lattice):
     return own.sample(z, X, Y)
 
 
-def measure(ref, scene, lattice, surface, reference_mean, reference_section=None):
+def measure(scene, lattice, surface, reference_mean, reference_section=None):
     """The case's metrics of one surface, with its RMSE against the particles' mean."""
     if scene["tool"].get("shape") == "pour":
         out = pm.pile_metrics(lattice, surface, scene["stroke"]["path_m"][0], scene["terrain"]["height_m"])
@@ -98,9 +98,9 @@ def case_rows(ref, scene, lattice, stage, backend_surfaces):
     mean = ref.mean(stage)
     is_pour = scene["tool"].get("shape") == "pour"
     base = None if is_pour else pm.stroke_metrics(lattice, mean, stroke_of(scene))["section_z_m"]
-    seeds = [measure(ref, scene, lattice, s, mean, base) for s in ref.surfaces[stage]]
+    seeds = [measure(scene, lattice, s, mean, base) for s in ref.surfaces[stage]]
     rows = PILE_ROWS if is_pour else STROKE_ROWS
-    backends = {b: measure(ref, scene, lattice, z, mean, base) for b, z in backend_surfaces.items()}
+    backends = {b: measure(scene, lattice, z, mean, base) for b, z in backend_surfaces.items()}
     table = []
     for key, label, scale in rows:
         m, sd = spread([s[key] * scale for s in seeds])

@@ -140,7 +140,7 @@ def _physics(geo, material):
     ])
 
 
-def _floor(geo, material, seed):
+def _floor(geo, material):
     """A frozen layer of touching grains (the mean diameter) whose tops lie at floor_z."""
     g = material["grains"]
     d = g["diameter_m"]
@@ -191,7 +191,7 @@ def bed_input(geo, material, seed, restart="bed.restart", dump="bed.dump"):
     return "\n".join([
         f"# sandbench particle reference: the bed (seed {seed})",
         _header(geo, material, fill + 2 * d),
-        _floor(geo, material, seed),
+        _floor(geo, material),
         f"region fill block {_fmt(x0 + gap)} {_fmt(x1 - gap)} {_fmt(y0 + gap)} {_fmt(y1 - gap)} "
         f"{_fmt(geo.floor_z + gap)} {_fmt(fill)} units box",
         f"lattice sc {_fmt(spacing)} origin 0.5 0.5 0.5",
@@ -238,7 +238,7 @@ def tool_schedule(geo, material, speed, bed_level):
     return points, tool_in
 
 
-def _piecewise(points, axis, t0):
+def _piecewise(points, axis):
     """An equal-style LAMMPS expression of one coordinate (axis 1, 2, 3) of a piecewise-linear
     trajectory, as a displacement from its first point; `v_tool_t` is the tool's clock."""
     base = points[0][axis]
@@ -284,9 +284,9 @@ def tool_input(geo, material, speed, bed_level, restart="bed.restart", tool_in_d
         _physics(geo, material),
         "reset_timestep 0",
         f"variable tool_t equal step*{_fmt(dt)}",
-        f"variable tool_dx equal {_piecewise(points, 1, 0)}",
-        f"variable tool_dy equal {_piecewise(points, 2, 0)}",
-        f"variable tool_dz equal {_piecewise(points, 3, 0)}",
+        f"variable tool_dx equal {_piecewise(points, 1)}",
+        f"variable tool_dy equal {_piecewise(points, 2)}",
+        f"variable tool_dz equal {_piecewise(points, 3)}",
         _tool_region(geo, points, height),
         f"fix tool sand wall/gran/region {_wall_contact(material)} region tool contacts",
         # The sand's force on the tool: minus the sum of the tool's contact forces on the grains.
@@ -324,7 +324,7 @@ def pour_input(geo, material, seed, pour_s, dump="final.dump"):
     return "\n".join([
         f"# sandbench particle reference: a pile poured at one point (seed {seed}, {count} grains)",
         _header(geo, material, z_hi + d),
-        _floor(geo, material, seed),
+        _floor(geo, material),
         "group sand type 1",
         _physics(geo, material),
         f"region pour_region cylinder z {_fmt(x)} {_fmt(y)} {_fmt(r)} {_fmt(z_lo)} {_fmt(z_hi)} units box",
