@@ -46,7 +46,9 @@ std::string scene_key_meaning(const std::string& key) {
       {"tool.sphere_radius_m", "sphere-cap profile: sphere radius"},
       {"tool.rim_width_m", "rim band outside the footprint where displaced sand goes (default: half the radius)"},
       {"tool.rim_forward_bias", "rim weighting towards the motion"},
-      {"tool.displacement", "where a moving tool puts the cut sand: a rim band around it, or bulldozed ahead of it"},
+      {"tool.displacement",
+       "where a moving tool puts the cut sand: bulldozed ahead of it at the angle of repose, or on a rim band around "
+       "it"},
       {"tool.volume_m3", "pour: volume poured per stamp"},
       {"stroke.path_m", "polyline, m"},
       {"stroke.z_m", "tool bottom z at each waypoint (default: surface - depth)"},

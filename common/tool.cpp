@@ -134,13 +134,7 @@ double ToolStamp::rim_weight_outside(const Vec2& p, double d) const {
   double directional = 1.0;
   const Vec2 offset = p - pose.xy;
   const double len = offset.norm();
-  const bool moving = motion_dir.squaredNorm() > 0.0;
-  if (rim.model == Displacement::Bulldoze && moving) {
-    const double ahead = offset.dot(motion_dir);
-    const double across = std::abs(offset.x() * motion_dir.y() - offset.y() * motion_dir.x());
-    return ahead > 0.0 && across <= half_width_m ? taper : 0.0;
-  }
-  if (len > 0.0 && moving) {
+  if (len > 0.0 && motion_dir.squaredNorm() > 0.0) {
     const double c = offset.dot(motion_dir) / len;
     directional = (1.0 + rim.forward_bias * c) / (1.0 + rim.forward_bias);
   }

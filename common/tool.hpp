@@ -25,16 +25,19 @@ std::optional<ToolShape> tool_shape_from(std::string_view name);          // dis
 std::optional<BottomProfile> bottom_profile_from(std::string_view name);  // flat | sphere_cap
 std::optional<Displacement> displacement_from(std::string_view name);     // rim | bulldoze
 
-// Where the displaced volume goes: a band just outside the footprint. `Rim`: all around it,
+// Where the displaced volume goes. `Rim`: a band just outside the footprint, all around it,
 // weighted towards the direction of motion (Sumner et al. 1999; Onoue & Nishita 2003).
-// `Bulldoze`: only the part of the band ahead of the footprint and within its width across the
-// motion, so the next stamp cuts it again and the sand is carried with the tool as a growing
-// front pile, which erosion spills to the sides at the angle of repose (the earthmoving
-// models of Holz et al. 2009); a stamp that does not move uses the rim.
+// `Bulldoze`: a pile ahead of the moving tool at the angle of repose (common/front_pile.hpp),
+// whose back part the next stamp cuts again, so the sand is carried with the tool as a growing
+// front pile that spills forward and to the sides (the earthmoving models of Holz et al.
+// 2009); a stamp that does not move, or whose pile would lie off the domain, uses the rim.
 struct RimRule {
-  double width_m = 0.01;      // band width outside the footprint boundary
-  double forward_bias = 0.8;  // rim: 0 uniform; 1 nothing behind the tool
-  Displacement model = Displacement::Rim;
+  double width_m = 0.01;                   // band width outside the footprint boundary
+  double forward_bias = 0.8;               // rim: 0 uniform; 1 nothing behind the tool
+  Displacement model = Displacement::Rim;  // scenes default to Bulldoze (tool.displacement)
+  // Bulldoze: the slope the front pile stands at, the material's critical slope (scenes set it
+  // from material.critical_angle_deg; this default is the material's default, 30 degrees).
+  double tan_repose = 0.57735026918962573;
 };
 
 struct ToolSpec {
@@ -82,13 +85,16 @@ struct ToolStamp {
   double pour_radius_m = 0.0;
 
   bool is_pour() const { return pour_volume_m3 > 0.0; }
+  // Whether the cut sand goes to a front pile (common/front_pile.hpp) rather than the rim.
+  bool bulldozes() const {
+    return rim.model == Displacement::Bulldoze && motion_dir.squaredNorm() > 0.0 && !footprint.empty();
+  }
   // Height of the tool bottom at p (meaningful inside the footprint).
   double bottom_z(const Vec2& p) const;
   bool contains(const Vec2& p) const { return point_in_polygon(footprint, p); }
-  // Weight of the displaced-volume deposit at p: 0 inside the footprint and beyond the
-  // band, else the taper falling linearly across the band times, for the rim,
-  // (1 + bias cos(phi)) / (1 + bias) with phi the angle between the motion and (p - pose),
-  // and for bulldozing 1 ahead of the pose within half_width_m across the motion, 0 elsewhere.
+  // Weight of the rim's deposit at p: 0 inside the footprint and beyond the band, else the
+  // taper falling linearly across the band times (1 + bias cos(phi)) / (1 + bias), phi the
+  // angle between the motion and (p - pose). (A bulldozing stamp's pile: front_pile.hpp.)
   double rim_weight(const Vec2& p) const;
   // The same for a point outside the footprint whose distance to its boundary is known.
   double rim_weight_outside(const Vec2& p, double distance) const;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "common/bilinear.hpp"
+#include "common/front_pile.hpp"
 #include "common/terrain.hpp"
 #include "grid/compensated_sum.hpp"
 #include "grid/grid_layout.hpp"
@@ -58,6 +59,54 @@ inline std::vector<Deposit> widened_rim(const GridLayout& layout, const ToolStam
     if (covers_grid && !any_outside) return rim;
   }
   return rim;
+}
+
+// The nodes of a bulldozing stamp's front pile (common/front_pile.hpp), each weighted by its
+// depth under the pile. The region sampled starts at the pile's reach on flat ground and widens
+// until it holds every node the pile covers (the pile carried from earlier stamps raises the
+// level: a round or two more). Empty when no node lies ahead of the tool.
+template <class Store>
+std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, double volume) {
+  const GridLayout& layout = grid.layout();
+  const double tan = s.rim.tan_repose;
+  const Aabb2 footprint_box = bounds(s.footprint);
+  const Aabb2 grid_box = layout.box();
+  double reach = std::max({front_pile_flat_reach(volume, 2.0 * s.half_width_m, tan), s.rim.width_m, layout.diagonal()});
+  std::vector<std::uint32_t> nodes;
+  std::vector<PileSample> samples;
+  // Each round at least 1.5 times wider: 64 outgrow any domain; the bound guards non-finite input.
+  for (int round = 0; round < 64; ++round) {
+    nodes.clear();
+    samples.clear();
+    const Aabb2 window = footprint_box.expanded(reach);
+    const NodeRange r = layout.nodes_in(window);
+    double lowest = HUGE_VAL;
+    for (std::size_t iy = r.y0; !r.empty && iy <= r.y1; ++iy) {
+      for (std::size_t ix = r.x0; ix <= r.x1; ++ix) {
+        const Vec2 p = layout.position(ix, iy);
+        if (!in_front_pile(s, p) || s.contains(p)) continue;
+        const double d = distance_to_boundary(s.footprint, p);
+        if (d > reach) continue;
+        const std::uint32_t k = layout.index(ix, iy);
+        nodes.push_back(k);
+        samples.push_back({d, grid.z(k), layout.area(k)});
+        lowest = std::min(lowest, samples.back().z_m);
+      }
+    }
+    if (samples.empty()) return {};
+    const double level = front_pile_level(samples, volume, tan);
+    const double needed = front_pile_reach_needed(level, lowest, tan);
+    const bool covers_grid = window.contains(grid_box.lo) && window.contains(grid_box.hi);
+    if (needed <= reach || covers_grid || !std::isfinite(needed)) {
+      std::vector<Deposit> pile;
+      for (std::size_t i = 0; i < nodes.size(); ++i)
+        if (const double depth = front_pile_depth(samples[i], level, tan); depth > 0.0)
+          pile.push_back({nodes[i], depth});
+      return pile;
+    }
+    reach = std::max(1.1 * needed, 1.5 * reach);
+  }
+  return {};
 }
 
 // Two circles about the footprint's vertex centroid that classify most nodes of the window
@@ -114,15 +163,20 @@ StampReport cut_and_push(Store& grid, const ToolStamp& s, std::vector<std::uint3
     }
   }
   if (cuts.empty()) return report;
+  CompensatedSum removed;
+  for (const Cut& c : cuts) removed.add(layout.area(c.node) * (grid.z(c.node) - c.bottom_z));
+  const double volume = removed.value();
+  if (s.bulldozes()) {
+    // Ahead of the tool; the rim when nothing lies ahead (the tool at the domain's far side).
+    if (std::vector<Deposit> pile = front_pile_nodes(grid, s, volume); !pile.empty()) rim = std::move(pile);
+  }
   if (rim.empty()) rim = widened_rim(layout, s);
   // No node outside the footprint (a tool larger than the domain): cutting would lose
   // the volume, so the stamp does nothing.
   if (rim.empty()) return report;
 
-  CompensatedSum removed, rim_weight;
-  for (const Cut& c : cuts) removed.add(layout.area(c.node) * (grid.z(c.node) - c.bottom_z));
+  CompensatedSum rim_weight;
   for (const Deposit& d : rim) rim_weight.add(layout.area(d.node) * d.weight);
-  const double volume = removed.value();
   const double per_weight = volume / rim_weight.value();
 
   for (const Cut& c : cuts) {

@@ -98,10 +98,14 @@ VertexHandle TinTerrain::split_edge(VertexHandle a, VertexHandle b, bool* insert
     if (m[axis] - box_.lo[axis] < near) m[axis] = box_.lo[axis];
     if (box_.hi[axis] - m[axis] < near) m[axis] = box_.hi[axis];
   }
+  return insert_on_surface(m, inserted);
+}
+
+VertexHandle TinTerrain::insert_on_surface(const Vec2& p, bool* inserted) {
   double change = 0.0;
-  const VertexHandle v = insert_point(m, surface_height(m), inserted, &change);
+  const VertexHandle v = insert_point(p, surface_height(p), inserted, &change);
   if (!*inserted) return v;
-  // The split itself keeps the surface; the Delaunay flips after it may not: their volume
+  // The insertion itself keeps the surface; the Delaunay flips after it may not: their volume
   // change (measured over the faces the insertion replaced) is given back to the new vertex
   // (tin.conserve_volume, the default).
   volume_change_ += change;

@@ -371,7 +371,8 @@ void TinTerrain::contour_points(StampWork& w) const {
   // Rim vertices where the band has none nearby: a ring in the band's middle to take the
   // deposit, and a ring on its outer edge so the deposit stays in the band (on a coarse TIN
   // a raised vertex would otherwise spread sand thinly over triangles reaching far away).
-  if (s.rim.width_m > w.gap) {
+  // (A bulldozing stamp's pile gets vertices of its own: fill_pile_lattice.)
+  if (s.rim.width_m > w.gap && !s.bulldozes()) {
     for (double offset : {0.5 * (w.gap + s.rim.width_m), s.rim.width_m}) {
       const std::vector<Vec2> ring = offset_polygon(footprint, offset);
       const double needed = 0.5 * perimeter(ring) / static_cast<double>(ring.size());
@@ -574,6 +575,7 @@ void TinTerrain::keep_resolving_vertices(std::vector<VertexHandle>& redundant) {
 }
 
 double TinTerrain::deposit_on_rim(StampWork& w, double deposit, StampReport& report) {
+  if (w.tool.bulldozes() && deposit > 0.0 && deposit_front_pile(w, deposit, report)) return deposit;
   // Weighted by the common rule. The band's vertices first get short edges (refine_around),
   // so the sand stays in the band.
   // A weight costs O(footprint corners): each vertex's is computed once, kept by address for

@@ -40,8 +40,6 @@ PreparedScene prepare_input(const SceneInput& in, const std::vector<Variant>& va
   Scene scene = load_scene(in.scene, all);
   if (replay) {
     validate_session(session, scene, "--replay " + in.replay);
-    // Sessions record the tools' shapes and rims, not the displacement model: the scene's.
-    for (ToolSpec& t : session.tools) t.rim.model = scene.tool.rim.model;
   }
   // Before anything is allocated: refuse what cannot fit, warn of what is large.
   std::vector<PlannedRun> runs;
@@ -52,7 +50,7 @@ PreparedScene prepare_input(const SceneInput& in, const std::vector<Variant>& va
   PreparedScene prepared = prepare_scene(std::move(scene));
   prepared.memory_limit_bytes = limit;
   if (replay) {
-    prepared.schedule = session_schedule(session);
+    prepared.schedule = session_schedule(session, prepared.scene.tool);
     prepared.scene.reference = ReferenceKind::None;
     prepared.replay = true;
   }

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <memory>
 #include <sstream>
+#include <utility>
 
 #include "common/atomic_file.hpp"
 #include "common/format.hpp"
@@ -295,13 +296,18 @@ void validate_session(const Session& session, const Scene& scene, const std::str
                      exact_number(kMaxStampCorners) + ")");
 }
 
-StampSchedule session_schedule(const Session& session) {
+StampSchedule session_schedule(const Session& session, const ToolSpec& scene_tool) {
   // The poses are shared with the generator; footprints are built one stamp at a time.
   struct Poses {
     std::vector<SessionStamp> stamps;
     std::vector<ToolSpec> tools;
   };
-  auto poses = std::make_shared<const Poses>(Poses{session.stamps, session.tools});
+  std::vector<ToolSpec> tools = session.tools;
+  for (ToolSpec& t : tools) {
+    t.rim.model = scene_tool.rim.model;
+    t.rim.tan_repose = scene_tool.rim.tan_repose;
+  }
+  auto poses = std::make_shared<const Poses>(Poses{session.stamps, std::move(tools)});
   StampSchedule schedule;
   for (std::size_t i = 1; i < session.stamps.size(); ++i)
     schedule.length_m += (session.stamps[i].pose.xy - session.stamps[i - 1].pose.xy).norm();

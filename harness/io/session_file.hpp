@@ -67,8 +67,11 @@ inline constexpr double kMaxCoordinate = 1e9;
 void validate_session(const Session& session, const Scene& scene, const std::string& option);
 
 // The stamps of a session as a lazy schedule (generations renumbered from 0): keeps a copy of
-// the poses, O(stamps) small records; footprints are built when a stamp is asked for.
-StampSchedule session_schedule(const Session& session);
+// the poses, O(stamps) small records; footprints are built when a stamp is asked for. Sessions
+// record the tools' shapes and rims, not where a tool puts the sand it cuts: every tool takes
+// the displacement model and its front pile's slope of `scene_tool` (the scene replayed on,
+// as the live session took them from its scene).
+StampSchedule session_schedule(const Session& session, const ToolSpec& scene_tool);
 
 // Adds `tool` to the session's tool table unless an identical one is there; its index.
 std::size_t session_tool_index(Session& session, const ToolSpec& tool);

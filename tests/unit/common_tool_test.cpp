@@ -1,8 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
+#include "common/front_pile.hpp"
 #include "common/tool.hpp"
 
 namespace sb {
@@ -78,31 +81,64 @@ TEST(RimRule, ZeroInsideAndBeyondBandMoreInFront) {
   EXPECT_GT(front, 5.0 * back);
 }
 
-// Bulldozing puts the sand only ahead of the footprint and within its width across the motion,
-// on any heading; a stamp that does not move spreads it on the rim all around.
-TEST(RimRule, BulldozeOnlyAheadWithinTheWidthOnAnyHeading) {
+// A bulldozing stamp's pile takes only points ahead of the pose within the footprint's half
+// width across the motion, on any heading; a stamp that does not move uses the rim all around.
+TEST(FrontPile, OnlyAheadOfThePoseOnAnyHeading) {
   ToolSpec t;
   t.shape = ToolShape::Box;
   t.half_size_m = {0.01, 0.015};  // 2 cm along the motion, 3 cm across
-  t.rim.width_m = 0.005;
   t.rim.model = Displacement::Bulldoze;
   for (const double heading : {0.0, 0.6, 2.0, -2.5}) {
     const Vec2 dir(std::cos(heading), std::sin(heading)), across(-dir.y(), dir.x());
     const Vec2 centre(0.3, -0.2);
     const ToolStamp s = make_stamp(t, {centre, 0.0, heading}, dir, 0);
+    EXPECT_TRUE(s.bulldozes());
     EXPECT_NEAR(s.half_width_m, 0.015, 1e-12);
-    auto at = [&](double along, double side) { return s.rim_weight(centre + along * dir + side * across); };
-    EXPECT_GT(at(0.012, 0.0), 0.5) << heading;             // just ahead, near full weight
-    EXPECT_GT(at(0.012, 0.0149), 0.5) << heading;          // ahead, at the edge of the width
-    EXPECT_EQ(at(0.012, 0.0151), 0.0) << heading;          // ahead but beside the width
-    EXPECT_EQ(at(0.0, 0.017), 0.0) << heading;             // beside the tool
-    EXPECT_EQ(at(-0.012, 0.0), 0.0) << heading;            // behind it
-    EXPECT_EQ(at(0.016, 0.0), 0.0) << heading;             // beyond the band
-    EXPECT_GT(at(0.011, 0.0), at(0.014, 0.0)) << heading;  // tapering across the band
+    auto at = [&](double along, double side) { return in_front_pile(s, centre + along * dir + side * across); };
+    EXPECT_TRUE(at(0.012, 0.0)) << heading;     // just ahead
+    EXPECT_TRUE(at(0.05, 0.0149)) << heading;   // ahead, at the edge of the width
+    EXPECT_FALSE(at(0.05, 0.0151)) << heading;  // ahead but beside the width
+    EXPECT_FALSE(at(0.005, 0.02)) << heading;   // beside the tool
+    EXPECT_FALSE(at(-0.012, 0.0)) << heading;   // behind
   }
   const ToolStamp still = make_stamp(t, {{0.0, 0.0}, 0.0, 0.0}, {0.0, 0.0}, 0);
-  EXPECT_GT(still.rim_weight({0.0, 0.017}), 0.0);
+  EXPECT_FALSE(still.bulldozes());
   EXPECT_GT(still.rim_weight({-0.012, 0.0}), 0.0);
+}
+
+// The level holds exactly the volume asked for over the samples given, whatever their order,
+// including samples the pile does not reach; on flat ground it is a ramp at the repose slope.
+TEST(FrontPile, LevelHoldsTheVolumeExactly) {
+  const double tan = std::tan(33.0 * std::numbers::pi / 180.0);
+  std::vector<PileSample> samples;
+  for (int i = 0; i < 200; ++i)  // distances 0.5..199.5 mm, uneven heights, uneven areas
+    samples.push_back({(i + 0.5) * 1e-3, 0.002 * std::sin(0.7 * i), 1e-6 * (1.0 + 0.5 * std::cos(1.3 * i))});
+  std::reverse(samples.begin(), samples.end());
+  for (const double volume : {1e-9, 3e-7, 2e-5, 1e-3}) {
+    const double level = front_pile_level(samples, volume, tan);
+    double held = 0.0;
+    for (const PileSample& p : samples) held += p.area_m2 * front_pile_depth(p, level, tan);
+    EXPECT_NEAR(held, volume, 1e-12 * volume) << volume;
+  }
+  EXPECT_TRUE(std::isnan(front_pile_level({}, 1e-6, tan)));
+  // Flat ground, one column of samples 1 mm apart of 1 mm^2 each: a ramp of height H and run
+  // H / tan holds H^2 / (2 tan) per unit width.
+  std::vector<PileSample> flat;
+  for (int i = 0; i < 1000; ++i) flat.push_back({i * 1e-4, 0.0, 1e-4});
+  const double level = front_pile_level(flat, 0.02 * 0.02 / (2.0 * tan), tan);
+  EXPECT_NEAR(level, 0.02, 2e-4);
+}
+
+// The flat reach holds the volume as a ramp across the blade: tan w R^2 / 2 = V.
+TEST(FrontPile, FlatReachHoldsTheVolume) {
+  const double tan = 0.65;
+  for (const double width : {0.001, 0.03, 1.0})
+    for (const double volume : {1e-9, 3.6e-5, 1e-2}) {
+      const double r = front_pile_flat_reach(volume, width, tan);
+      EXPECT_NEAR(tan * width * r * r / 2.0, volume, 1e-12 * volume);
+    }
+  EXPECT_EQ(front_pile_flat_reach(0.0, 0.03, tan), 0.0);
+  EXPECT_EQ(front_pile_flat_reach(1e-6, 0.0, tan), 0.0);
 }
 
 }  // namespace

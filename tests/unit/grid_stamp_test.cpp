@@ -1,4 +1,5 @@
-// Tool stamps on the grid: depth reached, volume conserved, rim weighted forwards, pours.
+// Tool stamps on the grid with the rim rule: depth reached, volume conserved, rim weighted
+// forwards, pours.
 #include <cmath>
 
 #include "grid_test_support.hpp"
@@ -10,8 +11,14 @@ template <class Real>
 class GridStamp : public ::testing::Test {};
 TYPED_TEST_SUITE(GridStamp, StorageTypes, StorageName);
 
+// The rim rule on the grid (tool.displacement = "rim"); bulldozing: terrain_bulldoze_test.cpp.
+Scene rim_scene(std::vector<std::string> overrides = {}, const std::string& text = flat_scene(kDisk)) {
+  overrides.insert(overrides.begin(), "tool.displacement=\"rim\"");
+  return scene(overrides, text);
+}
+
 TYPED_TEST(GridStamp, CutsToTheToolDepthAndConservesVolume) {
-  const Scene s = scene();
+  const Scene s = rim_scene();
   const auto t = make_grid<TypeParam>(s);
   const double v0 = t->volume();
   const ToolStamp st = stamp_at(s, {0.25, 0.25}, 0.09);
@@ -46,7 +53,7 @@ TYPED_TEST(GridStamp, CutsToTheToolDepthAndConservesVolume) {
 }
 
 TYPED_TEST(GridStamp, RimGetsMoreInFrontThanBehind) {
-  const Scene s = scene();
+  const Scene s = rim_scene();
   const auto t = make_grid<TypeParam>(s);
   const Vec2 centre{0.25, 0.25};
   const Vec2 motion = Vec2(1.0, 0.5).normalized();
@@ -67,7 +74,7 @@ TYPED_TEST(GridStamp, RimGetsMoreInFrontThanBehind) {
 
 TYPED_TEST(GridStamp, NothingOutsideTheInfluenceBoundsChanges) {
   // Rough initial terrain: a stamp that visited too much would show.
-  const Scene s = scene({"terrain.kind=\"dunes\"", "terrain.amplitude_m=0.05"});
+  const Scene s = rim_scene({"terrain.kind=\"dunes\"", "terrain.amplitude_m=0.05"});
   const auto t = make_grid<TypeParam>(s);
   const std::vector<TypeParam> before = t->heights().heights();
   const ToolStamp st = stamp_at(s, {0.2, 0.3}, 0.05);
@@ -86,7 +93,7 @@ TYPED_TEST(GridStamp, NothingOutsideTheInfluenceBoundsChanges) {
 }
 
 TYPED_TEST(GridStamp, ActiveSetHoldsTheChangedNodesAndTheirNeighbours) {
-  const Scene s = scene();
+  const Scene s = rim_scene();
   const auto t = make_grid<TypeParam>(s);
   const std::vector<TypeParam> before = t->heights().heights();
   t->stamp(stamp_at(s, {0.25, 0.25}, 0.09));
@@ -103,7 +110,7 @@ TYPED_TEST(GridStamp, ActiveSetHoldsTheChangedNodesAndTheirNeighbours) {
 }
 
 TYPED_TEST(GridStamp, SphereCapReachesItsProfile) {
-  const Scene s = scene({"tool.profile=\"sphere_cap\"", "tool.sphere_radius_m=0.05"});
+  const Scene s = rim_scene({"tool.profile=\"sphere_cap\"", "tool.sphere_radius_m=0.05"});
   const auto t = make_grid<TypeParam>(s);
   const double v0 = t->volume();
   const ToolStamp st = stamp_at(s, {0.25, 0.25}, 0.085);
@@ -122,7 +129,7 @@ TYPED_TEST(GridStamp, SphereCapReachesItsProfile) {
 // A box whose edges fall half way between nodes and a rim band narrower than that gap:
 // the band holds no node, so the deposit goes to the nearest nodes outside instead.
 TYPED_TEST(GridStamp, RimNarrowerThanACellStillReceivesTheVolume) {
-  const Scene s = scene({}, flat_scene("shape = \"box\"\nsize_m = [0.025, 0.025]\nrim_width_m = 0.001\n"));
+  const Scene s = rim_scene({}, flat_scene("shape = \"box\"\nsize_m = [0.025, 0.025]\nrim_width_m = 0.001\n"));
   const auto t = make_grid<TypeParam>(s);
   const double v0 = t->volume();
   const ToolStamp st = stamp_at(s, {0.25, 0.25}, 0.09);
@@ -143,7 +150,7 @@ TYPED_TEST(GridStamp, RimNarrowerThanACellStillReceivesTheVolume) {
 
 TYPED_TEST(GridStamp, ToolAtTheDomainEdgeConservesVolume) {
   // Moving off the domain with every bit of rim bias forwards: the rim in front is clipped.
-  const Scene s = scene({"tool.rim_forward_bias=1.0"});
+  const Scene s = rim_scene({"tool.rim_forward_bias=1.0"});
   const auto t = make_grid<TypeParam>(s);
   const double v0 = t->volume();
   for (const Vec2& xy : {Vec2(0.49, 0.25), Vec2(0.5, 0.5), Vec2(-0.02, 0.1), Vec2(0.25, 0.515)}) {
@@ -156,7 +163,7 @@ TYPED_TEST(GridStamp, ToolAtTheDomainEdgeConservesVolume) {
 }
 
 TYPED_TEST(GridStamp, ToolLargerThanTheDomainCutsNothing) {
-  const Scene s = scene({}, flat_scene("shape = \"box\"\nsize_m = [2.0, 2.0]\n"));
+  const Scene s = rim_scene({}, flat_scene("shape = \"box\"\nsize_m = [2.0, 2.0]\n"));
   const auto t = make_grid<TypeParam>(s);
   const std::vector<TypeParam> before = t->heights().heights();
   const StampReport r = t->stamp(stamp_at(s, {0.25, 0.25}, 0.0));
@@ -168,7 +175,7 @@ TYPED_TEST(GridStamp, ToolLargerThanTheDomainCutsNothing) {
 }
 
 TYPED_TEST(GridStamp, ToolAboveTheSurfaceCutsNothing) {
-  const Scene s = scene();
+  const Scene s = rim_scene();
   const auto t = make_grid<TypeParam>(s);
   const StampReport r = t->stamp(stamp_at(s, {0.25, 0.25}, 0.2));
   EXPECT_EQ(r.volume_removed_m3, 0.0);
@@ -177,7 +184,7 @@ TYPED_TEST(GridStamp, ToolAboveTheSurfaceCutsNothing) {
 }
 
 TYPED_TEST(GridStamp, PourAddsExactlyItsVolume) {
-  const Scene s = scene({}, flat_scene("shape = \"pour\"\nradius_m = 0.02\nvolume_m3 = 1e-4\n"));
+  const Scene s = rim_scene({}, flat_scene("shape = \"pour\"\nradius_m = 0.02\nvolume_m3 = 1e-4\n"));
   const auto t = make_grid<TypeParam>(s);
   double expected = t->volume();
   // Inside, at the border, outside the domain, and narrower than a cell.
@@ -203,7 +210,7 @@ TYPED_TEST(GridStamp, PourAddsExactlyItsVolume) {
 // highest at the node nearest to it. (Spread evenly over the nodes within the radius, these
 // pours landed centred 0.2 to 1.7 mm off their points on this 5 mm grid.)
 TYPED_TEST(GridStamp, APourLandsCentredOnItsPoint) {
-  const Scene s = scene({}, flat_scene("shape = \"pour\"\nradius_m = 0.02\nvolume_m3 = 1e-4\n"));
+  const Scene s = rim_scene({}, flat_scene("shape = \"pour\"\nradius_m = 0.02\nvolume_m3 = 1e-4\n"));
   for (const auto& [xy, radius] : std::vector<std::pair<Vec2, double>>{
            {{0.25, 0.25}, 0.02}, {{0.2512, 0.2471}, 0.02}, {{0.1234, 0.3456}, 0.0123}, {{0.3011, 0.1987}, 0.001}}) {
     const auto t = make_grid<TypeParam>(s);

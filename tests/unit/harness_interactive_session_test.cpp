@@ -84,7 +84,7 @@ TEST_F(Session_, RoundTripsBitForBit) {
   ASSERT_EQ(r.stamps.size(), 3u);
 
   // The schedules agree exactly: same footprints, poses, directions.
-  const StampSchedule a = session_schedule(s), b = session_schedule(r);
+  const StampSchedule a = session_schedule(s, ToolSpec{}), b = session_schedule(r, ToolSpec{});
   ASSERT_EQ(a.stamps.size(), b.stamps.size());
   for (std::size_t i = 0; i < a.stamps.size(); ++i) {
     const ToolStamp &x = a.stamps[i], &y = b.stamps[i];
@@ -207,7 +207,7 @@ TEST_F(Session_, RecordedStampsReplayExactly) {
   EXPECT_EQ(session.backend, "grid");
 
   PreparedScene replay = prepared;
-  replay.schedule = session_schedule(session);
+  replay.schedule = session_schedule(session, prepared.scene.tool);
   auto fresh = make_terrain("grid", prepared.scene, prepared.initial);
   const RunResult run = run_schedule(*fresh, replay);
   Raster live = prepared.raster_template;

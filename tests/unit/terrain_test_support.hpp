@@ -33,8 +33,10 @@ inline std::string flat_sand_scene(std::string_view size_m, std::string_view hei
   return text.append(rest);
 }
 
-// A 2 cm disk cutting 1 cm deep ([tool] keys).
-inline constexpr std::string_view kDisk2cm = "shape = \"disk\"\nradius_m = 0.02\ndepth_m = 0.01\n";
+// A 2 cm disk cutting 1 cm deep ([tool] keys), putting the sand on its rim: the model most
+// tests of the back-ends' mechanics were written to (bulldozing: terrain_bulldoze_test.cpp).
+inline constexpr std::string_view kDisk2cm =
+    "shape = \"disk\"\nradius_m = 0.02\ndepth_m = 0.01\ndisplacement = \"rim\"\n";
 
 inline ErosionRule rule_of(const Scene& s) {
   return ErosionRule::from(s.material, s.erosion.settle_tolerance_deg, s.erosion.rule);

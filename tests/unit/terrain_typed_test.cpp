@@ -14,28 +14,11 @@
 #include "common/scene.hpp"
 #include "common/schedule.hpp"
 #include "harness/run/backends.hpp"
+#include "terrain_backends.hpp"
 #include "terrain_test_support.hpp"
 
 namespace sb {
 namespace {
-
-// The TIN compensates retriangulation volume changes only when asked (tin.conserve_volume);
-// the grids' bookkeeping is exact by construction.
-struct Tin {
-  static constexpr const char* kName = "tin";
-  static std::vector<std::string> overrides() { return {"tin.conserve_volume=true"}; }
-  static constexpr double kVolumeTolerance = 1e-12;
-};
-struct Grid {
-  static constexpr const char* kName = "grid";
-  static std::vector<std::string> overrides() { return {}; }
-  static constexpr double kVolumeTolerance = 1e-12;
-};
-struct Sparse {
-  static constexpr const char* kName = "sparse";
-  static std::vector<std::string> overrides() { return {}; }
-  static constexpr double kVolumeTolerance = 1e-12;
-};
 
 const std::string kFlat = test::flat_sand_scene("0.3", "0.1", test::kDisk2cm, R"(
 [stroke]
@@ -99,14 +82,7 @@ class TerrainTyped : public ::testing::Test {
   }
 };
 
-struct BackendName {
-  template <class T>
-  static std::string GetName(int) {
-    return T::kName;
-  }
-};
-using Backends = ::testing::Types<Tin, Grid, Sparse>;
-TYPED_TEST_SUITE(TerrainTyped, Backends, BackendName);
+TYPED_TEST_SUITE(TerrainTyped, test::Backends, test::BackendName);
 
 TYPED_TEST(TerrainTyped, VolumeIsKeptByEveryPhase) {
   for (const std::string& text : {kFlat, kDunes}) {

@@ -150,7 +150,7 @@ TEST(TinSettleCascade, SmallRegionsAndStrokeBudgetsUseNoCascade) {
 // stroke ends, so the runner's settling budgets run the cascade.
 Scene deep_stroke(const std::string& rule) {
   return load_scene(SB_SOURCE_DIR "/experiments/scenes/flat_stroke.toml",
-                    {"tool.depth_m=0.2", "erosion.rule=\"" + rule + "\""});
+                    {"tool.depth_m=0.2", "erosion.rule=\"" + rule + "\"", "tool.displacement=\"rim\""});
 }
 
 struct Settled {

@@ -288,8 +288,17 @@ class TinTerrain final : public Terrain {
   // Of 1e's redundant vertices (in position order), those that resolve the floor at half
   // refine_m_ are taken out of the list (kept in the mesh). O(their stars).
   void keep_resolving_vertices(std::vector<VertexHandle>& redundant);
-  // 1d (cont.): `deposit` spread over the rim band; returns what was deposited.
+  // 1d (cont.): `deposit` spread over the rim band, or a bulldozing stamp's front pile;
+  // returns what was deposited.
   double deposit_on_rim(StampWork& w, double deposit, StampReport& report);
+  // front_pile.cpp: a bulldozing stamp's deposit heaped ahead of it (common/front_pile.hpp);
+  // false, and nothing changed, when no vertex lies ahead. O(lattice points in the pile's
+  // region, each located) per widening of the region; one or two widenings are usual.
+  bool deposit_front_pile(StampWork& w, double deposit, StampReport& report);
+  // Vertices on a lattice of refine_m_ (anchored at the domain's corner, so stamps share it)
+  // where the pile's region within `reach` of the footprint has none nearby: the pile's slopes
+  // resolved as erosion would resolve them, on a mesh that ahead of a tool is often coarse.
+  void fill_pile_lattice(const StampWork& w, double reach, StampReport& report);
   // 1f: the vertices whose heights changed join L_e with their neighbours, and L_r; of the
   // retriangulated region's other vertices only those next to a face steeper than critical.
   void activate(const StampWork& w, const std::vector<VertexHandle>& region_vertices);
@@ -319,6 +328,9 @@ class TinTerrain final : public Terrain {
   // erosion.cpp: splits edge (a, b) at its middle (volume change measured, and compensated
   // under tin.conserve_volume); returns the vertex there.
   VertexHandle split_edge(VertexHandle a, VertexHandle b, bool* inserted);
+  // Inserts a vertex at p on the surface (height interpolated), the flips' volume change
+  // measured and compensated as for a split; the vertex and its neighbours join L_e.
+  VertexHandle insert_on_surface(const Vec2& p, bool* inserted);
   // Whether m, the middle of edge (a, b), lies a hair beside a constrained edge or a border edge of
   // the two faces beside (a, b) (split_edge then refuses the split). O(1).
   bool beside_a_constraint(VertexHandle a, VertexHandle b, const Vec2& m) const;

@@ -1,0 +1,65 @@
+#pragma once
+// The front pile of a bulldozing tool (tool.displacement = "bulldoze"): the sand a moving tool
+// cuts is heaped ahead of it, in the corridor the footprint sweeps (ahead of the pose, within
+// the footprint's half width across the motion), up to a surface at the angle of repose that
+// falls away from the footprint,
+//
+//   z_pile(p) = H - tan(repose) * d(p),   d = distance from p to the footprint.
+//
+// The level H is the one at which the pile, filled onto the terrain as it is, holds exactly the
+// cut volume:
+//
+//   sum over samples of area * max(0, H - tan(repose) * d - z) = V.
+//
+// The sand already ahead (the pile of the earlier stamps, carried with the tool because each
+// stamp cuts its back part again) counts as terrain, so the pile grows with the cut and runs out
+// ahead at the angle of repose within the stamp, where a band of fixed width ahead made it a
+// column that erosion had to take down over many steps (0.18 m on a 15 mm cut). Erosion spills
+// the corridor's sides, which the moving tool leaves behind as side berms. Each back-end collects
+// its nodes or vertices as samples, asks for the level and deposits in proportion to the depths;
+// the stamp normalises the deposit, so the volume stays exact.
+//
+// (The particles carry the pile's flanks beside the blade with them; a pile filled beside the
+// front half of the tool too, or around the blade's corners, left those flanks behind as berms
+// three to four times the particles'. Carrying them needs state between stamps, which this
+// model does not keep: results/particles.md shows what the corridor costs.)
+#include <vector>
+
+#include "common/geometry.hpp"
+
+namespace sb {
+
+struct ToolStamp;
+
+struct PileSample {
+  double distance_m;  // to the footprint
+  double z_m;         // terrain height before the deposit
+  double area_m2;     // the sample's share of the surface
+};
+
+// Whether p takes part in a bulldozing stamp's front pile: outside the footprint (the caller
+// knows), ahead of the pose along the motion and within the footprint's half width across it.
+// O(1).
+bool in_front_pile(const ToolStamp& s, const Vec2& p);
+
+// The distance from the footprint within which the pile holding `volume_m3` on flat ground
+// ends, ahead of a blade `width_m` wide: the ramp's R with tan * width * R^2 / 2 = V; 0 when
+// the width or the volume is not positive. The first region a back-end samples; it widens the
+// region while the level asks for more (front_pile_reach_needed). O(1).
+double front_pile_flat_reach(double volume_m3, double width_m, double tan_repose);
+
+// The level H above. Exact for the samples given (sorted thresholds, no iteration):
+// O(n log n). Samples with zero area are ignored; NaN when no sample has area.
+double front_pile_level(const std::vector<PileSample>& samples, double volume_m3, double tan_repose);
+
+// How far from the footprint a pile of level H can reach over terrain no lower than
+// `lowest_z_m`: a region sampled to at least this distance holds every point the pile
+// covers. O(1).
+inline double front_pile_reach_needed(double level_m, double lowest_z_m, double tan_repose) {
+  return (level_m - lowest_z_m) / tan_repose;
+}
+
+// The deposit's depth at a sample for level H (the weight the stamp normalises). O(1).
+double front_pile_depth(const PileSample& s, double level_m, double tan_repose);
+
+}  // namespace sb
