@@ -118,9 +118,11 @@ def summary(X, F, direction, k, b, mu):
     (horizontal and vertical parts)."""
     model = predict(X, k, b, mu)
     d = model - F
-    return {"against_ref": float(np.mean(-(F[:, :2] @ direction))), "against_model": float(np.mean(-(model[:, :2] @ direction))),
+    return {"against_ref": float(np.mean(-(F[:, :2] @ direction))),
+            "against_model": float(np.mean(-(model[:, :2] @ direction))),
             "up_ref": float(np.mean(F[:, 2])), "up_model": float(np.mean(model[:, 2])),
-            "rms_xy": float(np.sqrt(np.mean(np.sum(d[:, :2] ** 2, axis=1)))), "rms_z": float(np.sqrt(np.mean(d[:, 2] ** 2)))}
+            "rms_xy": float(np.sqrt(np.mean(np.sum(d[:, :2] ** 2, axis=1)))),
+            "rms_z": float(np.sqrt(np.mean(d[:, 2] ** 2)))}
 
 
 def trend(distance, resistance):
@@ -191,8 +193,8 @@ def scatter(data):
 
 HEADERS = ["case", "parameters", "k, N/m", "b, N s/m", "mu", "plunge: up, particles N", "plunge: up, model N",
            "cutting: against the motion, particles N", "cutting: against the motion, model N",
-           "cutting: up, particles N", "cutting: up, model N", "plunge: RMS |model - particles|, N",
-           "cutting: RMS |model - particles|, N", "drag-friction column correlation"]
+           "cutting: up, particles N", "cutting: up, model N", "plunge: RMS of model - particles, N",
+           "cutting: RMS of model - particles, N", "drag-friction column correlation"]
 
 
 def run(ctx, refs, sessions, parameters):
@@ -245,7 +247,8 @@ def run(ctx, refs, sessions, parameters):
         out["cases"][case] = {
             "shipped": {"k": k0, "b": b0, "mu": mu0},
             "plunge_k": fits["plunge, b held"]["k"], "cutting_k": fits["cut, b held"]["k"],
-            "cutting_mu": fits["cut, b held"]["mu"], "free_b": fits["cut, free"]["b"], "free_mu": fits["cut, free"]["mu"],
+            "cutting_mu": fits["cut, b held"]["mu"],
+            "free_b": fits["cut, free"]["b"], "free_mu": fits["cut, free"]["mu"],
             "free_cutting_correlation": fits["cut, free"]["correlation"],
             "separable_in_cutting": fits["cut, free"]["separable"],
             "plunge": summary(data["plunge"]["X"], data["plunge"]["F"], direction, calibrated["k"], b_held, 0.0),
@@ -279,7 +282,8 @@ def figure(ctx, cases, shipped, calibrated):
         backend = both["cutting"]["backend"][0]
         for ax, (name, part) in zip(row, parts.items()):
             values = part(seeds[:, :, 4:7])
-            ax.fill_between(t_ref, values.min(axis=0), values.max(axis=0), color="0.8", label="particles (seeds' range)")
+            ax.fill_between(t_ref, values.min(axis=0), values.max(axis=0), color="0.8",
+                            label="particles (seeds' range)")
             ax.plot(t_ref, values.mean(axis=0), color="k", lw=1.2, label="particles (mean)")
             for label, params, colour in [("model, scene's parameters", shipped[case], "C3"),
                                           ("model, calibrated", calibrated, "C0")]:
