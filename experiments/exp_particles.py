@@ -14,6 +14,10 @@ standard deviation over their seeds.
 
 How much of a back-end's distance from the particles is the shared model and how much its
 discretisation: the back-ends' distance from each other bounds the discretisation's share.
+
+The tool's force: the particles' trajectory is replayed through `sandbench interactive` on every
+back-end, and the haptic force model's parameters are fitted to the particles' force on those
+replays (haptic_calibration.py).
 """
 import math
 import sys
