@@ -32,8 +32,11 @@ import sbrun
 BACKENDS = ("grid", "tin")
 RECORDING = sbrun.ROOT / "experiments" / "haptics_stroke.csv"
 SCENE = sbrun.DIAGONAL_SCENE
-FORCE_HEADER = ["t", "fx", "fy", "fz", "penetration_m", "model_fx", "model_fy", "model_fz"]
-FORCE_HEADER_WITHOUT_MODEL = FORCE_HEADER[:5]  # sessions recorded before the model's force was
+FORCE_HEADER = ["t", "fx", "fy", "fz", "penetration_m", "model_fx", "model_fy", "model_fz", "contact_fraction",
+                "model_vx", "model_vy", "model_vz"]
+# Sessions recorded before the model's contact fraction and velocity were, and before its force was.
+FORCE_HEADER_WITHOUT_CONTACT = FORCE_HEADER[:8]
+FORCE_HEADER_WITHOUT_MODEL = FORCE_HEADER[:5]
 TRAJECTORY_HEADER = ["t", "x", "y", "z", "buttons"]
 
 
@@ -75,19 +78,18 @@ def replay(sandbench, backend, workdir, overrides=(), recording=None, reuse=Fals
 
 
 def read_session(session):
-    """The recorded arrays: t, f (sent), model (the model's force at the same pose; NaN when the session has
-    none), depth, z, xy."""
+    """The recorded arrays: t, f (sent), model (the model's force at the same pose), depth, contact and
+    velocity (the model's d, c and v on the newest patch: force_model.hpp), z, xy; a column the session
+    lacks (older files) is NaN."""
     import numpy as np
     tables = read_tables(session)
     traj = np.array(tables[tuple(TRAJECTORY_HEADER)])
-    if tuple(FORCE_HEADER) in tables:
-        force = np.array(tables[tuple(FORCE_HEADER)])
-        model = force[:, 5:8]
-    else:
-        force = np.array(tables[tuple(FORCE_HEADER_WITHOUT_MODEL)])
-        model = np.full((len(force), 3), np.nan)
-    return {"t": force[:, 0], "f": force[:, 1:4], "model": model, "depth": force[:, 4], "z": traj[:, 3],
-            "xy": traj[:, 1:3]}
+    header = next(h for h in (FORCE_HEADER, FORCE_HEADER_WITHOUT_CONTACT, FORCE_HEADER_WITHOUT_MODEL)
+                  if tuple(h) in tables)
+    force = np.array(tables[tuple(header)])
+    force = np.hstack([force, np.full((len(force), len(FORCE_HEADER) - len(header)), np.nan)])
+    return {"t": force[:, 0], "f": force[:, 1:4], "model": force[:, 5:8], "depth": force[:, 4],
+            "contact": force[:, 8], "velocity": force[:, 9:12], "z": traj[:, 3], "xy": traj[:, 1:3]}
 
 
 def _run_interactive(sandbench, backend, recording, session, stats, overrides, scene=SCENE):

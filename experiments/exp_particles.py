@@ -14,6 +14,10 @@ standard deviation over their seeds.
 
 How much of a back-end's distance from the particles is the shared model and how much its
 discretisation: the back-ends' distance from each other bounds the discretisation's share.
+
+The tool's force: the particles' trajectory is replayed through `sandbench interactive` on every
+back-end, and the haptic force model's parameters are fitted to the particles' force on those
+replays (haptic_calibration.py).
 """
 import math
 import sys
@@ -22,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 import particle_metrics as pm
+import haptic_calibration
 import sbrun
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "dem"))
@@ -191,12 +196,24 @@ def run_name(ref, label):
     return f"particles/{ref.case}-{label.replace(' ', '-')}"
 
 
-def default_displacement(ctx):
-    """The scenes' default `tool.displacement`, as the binary's validator states it."""
+def key_default(ctx, key):
+    """A scene key's default as the binary's validator states it (a string: `"rim"`, `800`)."""
     for line in ctx.sandbench_cmd("scene-keys").splitlines():
-        if line.startswith("tool.displacement "):
-            return line.split('default "', 1)[1].split('"', 1)[0]
-    raise RuntimeError("sandbench scene-keys lists no tool.displacement")
+        if line.startswith(key + " "):
+            return line.split(", default ", 1)[1].rsplit(", allowed ", 1)[0]
+    raise RuntimeError(f"sandbench scene-keys lists no {key}")
+
+
+def default_displacement(ctx):
+    """The scenes' default `tool.displacement`."""
+    return key_default(ctx, "tool.displacement").strip('"')
+
+
+def force_parameters(ctx, scene):
+    """The haptic force model's (k, b, mu) of a scene: its [material] keys, else their defaults."""
+    keys = ("stiffness_n_per_m", "drag_n_s_per_m", "friction")
+    material = scene.get("material", {})
+    return tuple(float(material.get(k, key_default(ctx, f"material.{k}"))) for k in keys)
 
 
 def variants(default):
@@ -226,10 +243,10 @@ def mean_force(t, xy, f):
 
 
 def model_forces(ctx, ref):
-    """The haptic force model's force on the particles' own tool trajectory (seed 1's), replayed
-    through `sandbench interactive` on every back-end (the model's force at the device's pose, as
-    the session records it); {} without xvfb-run, and in the tiny profile (the replays run in real
-    time, and their forces follow the machine's timing)."""
+    """The haptic force model on the particles' own tool trajectory (seed 1's), replayed through
+    `sandbench interactive` on every back-end: {back-end: the recorded session's arrays
+    (exp_haptics.read_session)}; {} without xvfb-run, and in the tiny profile (the replays run in
+    real time, and their forces follow the machine's timing)."""
     import shutil
     import exp_haptics
     if shutil.which("xvfb-run") is None or not ref.forces or ctx.profile_name == "tiny":
@@ -247,23 +264,25 @@ def model_forces(ctx, ref):
     reuse = ctx.is_current(folder, what)
     out = {}
     for b in BACKENDS:
-        _, rec = exp_haptics.replay(ctx.sandbench, b, folder, recording=trajectory, reuse=reuse,
-                                    scene=sbrun.ROOT / ref.scene)
-        model = rec["model"] if np.all(np.isfinite(rec["model"])) else rec["f"]
-        out[b] = mean_force(rec["t"], rec["xy"], model)
+        _, out[b] = exp_haptics.replay(ctx.sandbench, b, folder, recording=trajectory, reuse=reuse,
+                                       scene=sbrun.ROOT / ref.scene)
     ctx.mark_current(folder, what)
     return out
 
 
-def tool_force_table(ctx, refs):
+def tool_force_table(ctx, refs, sessions):
     """The tool's force while cutting: the particles' (mean ± sd over seeds) and the haptic force
-    model's on the same trajectory, per back-end."""
+    model's on the same trajectory (the model's force at the device's pose, as the session
+    records it), per back-end."""
     rows = []
     for ref in refs:
         if not ref.forces:
             continue
         means = np.array([mean_force(f[:, 0], f[:, 1:3], f[:, 4:7]) for f in ref.forces.values()])
-        model = model_forces(ctx, ref)
+        model = {}
+        for b, rec in sessions.get(ref.case, {}).items():
+            force = rec["model"] if np.all(np.isfinite(rec["model"])) else rec["f"]
+            model[b] = mean_force(rec["t"], rec["xy"], force)
         row = [ref.case, f"{means[:, 0].mean():.2f} ± {means[:, 0].std():.2f}",
                f"{means[:, 1].mean():.2f} ± {means[:, 1].std():.2f}"]
         for b in BACKENDS:
@@ -324,12 +343,15 @@ def run(ctx):
         cases.append(case)
     if not cases:
         return {"cases": [], "table": "", "figures": {}, "displacement": default, "compared": other,
-                "tool_force": "", "summary": {}}
+                "tool_force": "", "force_fit": {}, "summary": {}}
     md = ctx.table("particles", ["case", "surface", "metric", "particles (mean ± sd over seeds)", *names], rows_csv)
     figures = {"sections": section_figure(ctx, cases, names), "difference": difference_figure(ctx, cases),
                "speed": speed_figure(ctx, cases, names)}
     out = values(cases, md, figures, other)
-    out.update({"displacement": default, "compared": other, "tool_force": tool_force_table(ctx, refs)})
+    sessions = {ref.case: model_forces(ctx, ref) for ref in refs if ref.forces}
+    out.update({"displacement": default, "compared": other, "tool_force": tool_force_table(ctx, refs, sessions),
+                "force_fit": haptic_calibration.run(ctx, refs, sessions, {ref.case: force_parameters(ctx, scene_of(ref))
+                                                                      for ref in refs})})
     return out
 
 
@@ -349,10 +371,10 @@ def values(cases, table, figures, other):
                          "dilation_pct": 100 * c["dilation"][0], "dilation_sd_pct": 100 * c["dilation"][1],
                          "speedup_min": min(speedup), "speedup_max": max(speedup),
                          "other_rmse_mm": {b: c["backends"][f"{b} {other}"]["section_rmse_m"] * 1e3 for b in BACKENDS},
-                         "verdict": ("the shared tool model, not a discretisation: the back-ends agree with each "
-                                     "other far better than with the grains" if shared else
-                                     "partly the discretisation: the back-ends differ from each other by a sizeable "
-                                     "part of their distance from the grains")})
+                         "verdict": ("the shared tool model: the back-ends agree far better with each other "
+                                     "than with the grains" if shared else
+                                     "partly the discretisation: the back-ends differ by a sizeable part of their "
+                                     "distance from the grains")})
             for b in BACKENDS:  # the report's summary table joins the cases' cells
                 summary.setdefault(b, {}).setdefault("accuracy vs particle sand", [])
                 summary[b]["accuracy vs particle sand"].append(f"{c['case']} {rmse[b] * 1e3:.1f} mm")

@@ -79,6 +79,7 @@ Vec3 ServoCore::render(ServoState& s, double dt) {
   const Vec3 x = coupled ? coupling_.tool_position() : device_x;
   const Vec3 v = coupled ? coupling_.tool_velocity() : velocity_;
   s.tool_position_m = x;
+  s.tool_velocity_m_s = v;
 
   // The model on the patch the servo holds, and when a newer one is waiting, on that one too:
   // the difference at the same pose is the jump the blend fades out.

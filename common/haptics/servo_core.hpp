@@ -34,13 +34,14 @@ struct ServoState {
   bool nonfinite = false;  // the model's force was not finite; zero was sent
   std::uint64_t patch_version = 0;
   // Rendering (rendering.hpp).
-  Vec3 tool_position_m{0.0, 0.0, 0.0};  // where the model was evaluated: the device, or the coupled tool
-  Vec3 blend_offset_n{0.0, 0.0, 0.0};   // what is left of earlier patches' forces
-  bool patch_switched = false;          // a new patch arrived this tick
-  bool rate_limited = false;            // the force-rate limit held the force back
-  bool passivity_active = false;        // the passivity controller added damping
-  double passivity_energy_j = 0.0;      // the observer's energy so far (> 0: energy created)
-  double force_step_n = 0.0;            // |force - force of the previous tick|
+  Vec3 tool_position_m{0.0, 0.0, 0.0};    // where the model was evaluated: the device, or the coupled tool
+  Vec3 tool_velocity_m_s{0.0, 0.0, 0.0};  // the velocity it was evaluated with (that point's)
+  Vec3 blend_offset_n{0.0, 0.0, 0.0};     // what is left of earlier patches' forces
+  bool patch_switched = false;            // a new patch arrived this tick
+  bool rate_limited = false;              // the force-rate limit held the force back
+  bool passivity_active = false;          // the passivity controller added damping
+  double passivity_energy_j = 0.0;        // the observer's energy so far (> 0: energy created)
+  double force_step_n = 0.0;              // |force - force of the previous tick|
   // Running counters of the loop (filled by ServoLoop).
   std::uint64_t missed_deadlines = 0;
   double tick_us = 0.0, tick_us_max = 0.0, servo_hz = 0.0, force_max_n = 0.0;

@@ -85,6 +85,8 @@ void ServoLoop::run() {
       r.force_n = s.force_n;
       r.penetration_m = s.model.penetration_m;
       r.model_force_n = s.model_force_n;
+      r.contact_fraction = s.model.contact_fraction;
+      r.model_velocity_m_s = s.tool_velocity_m_s;
       if (!samples_.push(r)) ++stats_.samples_dropped;
     }
 

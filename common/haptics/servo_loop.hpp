@@ -36,6 +36,10 @@ struct ServoSample {
   Vec3 force_n{0.0, 0.0, 0.0};
   double penetration_m = 0.0;
   Vec3 model_force_n{0.0, 0.0, 0.0};  // ServoState::model_force_n
+  // The rest of what the model's force on the newest patch was computed from (with
+  // penetration_m and the scene's parameters): its contact fraction and velocity.
+  double contact_fraction = 0.0;
+  Vec3 model_velocity_m_s{0.0, 0.0, 0.0};  // ServoState::tool_velocity_m_s
 };
 
 // The haptic statistics of README "Interactive mode and haptics" (servo_hz, tick_us.*, missed_deadlines, force_max_n)

@@ -287,7 +287,8 @@ void Simulation::drain_samples() {
   while (servo_.samples().pop(r)) {
     if (!recording_ || !r.valid) continue;
     session_.trajectory.samples.push_back({r.t_s, r.position_m, r.buttons});
-    session_.forces.push_back({r.t_s, r.force_n, r.penetration_m, r.model_force_n});
+    session_.forces.push_back(
+        {r.t_s, r.force_n, r.penetration_m, r.model_force_n, r.contact_fraction, r.model_velocity_m_s});
   }
 }
 

@@ -23,9 +23,13 @@ using haptics::csv_number;
 using haptics::CsvFile;
 using haptics::CsvTable;
 
-const std::vector<std::string> kForceHeader{"t", "fx", "fy", "fz", "penetration_m", "model_fx", "model_fy", "model_fz"};
-// Sessions written before the model's force was recorded.
-const std::vector<std::string> kForceHeaderWithoutModel{"t", "fx", "fy", "fz", "penetration_m"};
+const std::vector<std::string> kForceHeader{
+    "t",        "fx",       "fy",      "fz", "penetration_m", "model_fx", "model_fy", "model_fz", "contact_fraction",
+    "model_vx", "model_vy", "model_vz"};
+// Sessions written before the contact fraction and velocity were recorded, and before the
+// model's force was: each a prefix of the current header.
+const std::vector<std::string> kForceHeaderWithoutContact(kForceHeader.begin(), kForceHeader.begin() + 8);
+const std::vector<std::string> kForceHeaderWithoutModel(kForceHeader.begin(), kForceHeader.begin() + 5);
 const std::vector<std::string> kToolHeader{
     "tool",    "shape",       "radius_m",         "size_x_m",       "size_y_m", "sides", "profile", "sphere_radius_m",
     "depth_m", "rim_width_m", "rim_forward_bias", "pour_volume_m3", "polygon_m"};
@@ -112,7 +116,9 @@ void write_session(const std::filesystem::path& file, const Session& s) {
         out << exact_number(f.t_s) << "," << exact_number(f.force_n.x()) << "," << exact_number(f.force_n.y()) << ","
             << exact_number(f.force_n.z()) << "," << exact_number(f.penetration_m) << ","
             << exact_number(f.model_force_n.x()) << "," << exact_number(f.model_force_n.y()) << ","
-            << exact_number(f.model_force_n.z()) << "\n";
+            << exact_number(f.model_force_n.z()) << "," << exact_number(f.contact_fraction) << ","
+            << exact_number(f.model_velocity_m_s.x()) << "," << exact_number(f.model_velocity_m_s.y()) << ","
+            << exact_number(f.model_velocity_m_s.z()) << "\n";
     }
     out << join(kToolHeader) << "\n";
     for (std::size_t i = 0; i < s.tools.size(); ++i) out << i << "," << tool_fields(s.tools[i]) << "\n";
@@ -177,22 +183,23 @@ Session session_from(const CsvFile& f, const std::string& option) {
       }
     }
     if (f.find(haptics::kTrajectoryHeader)) s.trajectory = haptics::trajectory_from(f);
-    if (const CsvTable* t = f.find(kForceHeader)) {
-      for (std::size_t r = 0; r < t->rows.size(); ++r) {
-        s.forces.push_back({csv_number(f, *t, r, 0),
-                            {csv_number(f, *t, r, 1), csv_number(f, *t, r, 2), csv_number(f, *t, r, 3)},
-                            csv_number(f, *t, r, 4),
-                            {csv_number(f, *t, r, 5), csv_number(f, *t, r, 6), csv_number(f, *t, r, 7)}});
-        if (r > 0) csv_check_time_order(f, *t, r, 0, s.forces[r - 1].t_s, s.forces[r].t_s);
+    // The force table in the newest layout found; columns a file lacks stay 0.
+    const CsvTable* forces = nullptr;
+    std::size_t columns = 0;
+    for (const auto* header : {&kForceHeader, &kForceHeaderWithoutContact, &kForceHeaderWithoutModel})
+      if ((forces = f.find(*header))) {
+        columns = header->size();
+        break;
       }
-    } else if (const CsvTable* old = f.find(kForceHeaderWithoutModel)) {
-      for (std::size_t r = 0; r < old->rows.size(); ++r) {
-        s.forces.push_back({csv_number(f, *old, r, 0),
-                            {csv_number(f, *old, r, 1), csv_number(f, *old, r, 2), csv_number(f, *old, r, 3)},
-                            csv_number(f, *old, r, 4),
-                            {0.0, 0.0, 0.0}});
-        if (r > 0) csv_check_time_order(f, *old, r, 0, s.forces[r - 1].t_s, s.forces[r].t_s);
-      }
+    for (std::size_t r = 0; forces && r < forces->rows.size(); ++r) {
+      auto cell = [&](std::size_t c) { return c < columns ? csv_number(f, *forces, r, c) : 0.0; };
+      s.forces.push_back({cell(0),
+                          {cell(1), cell(2), cell(3)},
+                          cell(4),
+                          {cell(5), cell(6), cell(7)},
+                          cell(8),
+                          {cell(9), cell(10), cell(11)}});
+      if (r > 0) csv_check_time_order(f, *forces, r, 0, s.forces[r - 1].t_s, s.forces[r].t_s);
     }
     const CsvTable* tools = f.find(kToolHeader);
     const CsvTable* stamps = f.find(kStampHeader);

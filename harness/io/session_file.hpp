@@ -5,9 +5,12 @@
 //   # sandbench session 1 / # scene: ... / # backend: ... / # set key=value (scene overrides
 //     the session made, e.g. material sliders; replay applies them before its own --set)
 //   t,x,y,z,buttons                 the device trajectory (README: the replay format)
-//   t,fx,fy,fz,penetration_m,model_fx,model_fy,model_fz   the force sent at each of those ticks
-//     and the model's force at the same pose (ServoState::model_force_n); files without the
-//     model's columns still read (model force 0)
+//   t,fx,fy,fz,penetration_m,model_fx,model_fy,model_fz,contact_fraction,model_vx,model_vy,model_vz
+//     the force sent at each of those ticks, the model's force at the same pose
+//     (ServoState::model_force_n), and what the model's force on the newest patch was
+//     computed from besides the scene's parameters (penetration d, contact fraction c, the
+//     velocity v: force_model.hpp); files without the last four columns still read (c and v
+//     0), and so do files without the model's force (0 too)
 //   tool,shape,radius_m,...         every tool used, in full
 //   stamp,t,x,y,bottom_z,heading_rad,dir_x,dir_y,tool   every stamp applied, in order
 // Numbers are written with round-trip precision, so replayed stamps are the recorded ones
@@ -35,7 +38,9 @@ struct SessionForce {
   double t_s = 0.0;
   Vec3 force_n{0.0, 0.0, 0.0};
   double penetration_m = 0.0;
-  Vec3 model_force_n{0.0, 0.0, 0.0};  // the model's force at the same pose, blend included
+  Vec3 model_force_n{0.0, 0.0, 0.0};       // the model's force at the same pose, blend included
+  double contact_fraction = 0.0;           // c of the model on the newest patch
+  Vec3 model_velocity_m_s{0.0, 0.0, 0.0};  // the velocity the model was evaluated with
 };
 
 struct Session {

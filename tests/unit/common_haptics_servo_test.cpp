@@ -66,6 +66,38 @@ TEST(HapticsServoCore, EstimatesVelocityFromPositions) {
   EXPECT_TRUE(s.velocity_m_s.isApprox(v, 1e-6)) << s.velocity_m_s.transpose();
 }
 
+// The state holds everything the model's force was computed from: with the scene's
+// parameters, k d z^ - b c v - mu k d v_xy / |v_xy| of the recorded penetration d, contact
+// fraction c and velocity v is the model's force (what a calibration against other forces
+// fits, experiments/haptic_calibration.py). A tool half a contact depth into the sand, so c < 1.
+TEST(HapticsServoCore, StateHoldsWhatTheModelsForceWasComputedFrom) {
+  SharedPoseDevice device("test", limits(100.0));
+  PatchBuffer patches;
+  const double k = 900.0, b = 7.0, mu = 0.3;
+  publish(patches, test::flat_patch(0.1, kCentre, ForceParams::from(test::sand(k, b, mu), test::disk(0.02))));
+  ServoCore core(device, patches, 40.0, test::raw_rendering());
+  core.start();
+  const Vec3 v(0.05, -0.02, -0.002);
+  ServoState s;
+  for (int i = 0; i < 300; ++i) {
+    const double t = i * 0.001;
+    device.set_pose(Vec3(kCentre.x(), kCentre.y(), 0.1 - 0.5 * kContactDepth_m) + t * v, 0);
+    s = core.step(t);
+  }
+  ASSERT_TRUE(s.model.in_contact);
+  EXPECT_FALSE(s.model.outside_patch);
+  EXPECT_GT(s.model.contact_fraction, 0.1);
+  EXPECT_LT(s.model.contact_fraction, 0.99);
+  EXPECT_EQ(s.tool_velocity_m_s, s.velocity_m_s);  // no coupling: the device's own velocity
+  const double d = s.model.penetration_m, c = s.model.contact_fraction;
+  const Vec3& u = s.tool_velocity_m_s;
+  const Vec2 along = u.head<2>() / std::max(u.head<2>().norm(), kFrictionVelocityEps);
+  const Vec3 expected(-b * c * u.x() - mu * k * d * along.x(), -b * c * u.y() - mu * k * d * along.y(),
+                      k * d - b * c * u.z());
+  EXPECT_LT((s.model.force_n - expected).norm(), 1e-12 * expected.norm()) << s.model.force_n.transpose();
+  EXPECT_EQ(s.model_force_n, s.model.force_n);  // no blend
+}
+
 // The loop with a replay device pressing into the sand and a second thread publishing
 // patches all the while, as the simulation does. Every force must be finite and within the
 // limit; the statistics must be coherent. The test waits for events (the replay played
@@ -136,12 +168,16 @@ TEST(HapticsServoLoop, RunsBesideAPublisherAndKeepsForcesWithinLimits) {
   std::uint64_t samples = 0;
   double last_t = -1.0;
   bool ordered = true;
+  bool contact_recorded = true;
   while (loop.samples().pop(r)) {
+    // In sand the contact fraction is recorded with the penetration; out of it both are 0.
+    contact_recorded &= (r.penetration_m > 0.0) == (r.contact_fraction > 0.0) && r.contact_fraction <= 1.0;
     ordered &= r.t_s > last_t;
     last_t = r.t_s;
     ++samples;
   }
   EXPECT_TRUE(ordered);
+  EXPECT_TRUE(contact_recorded);
   EXPECT_EQ(samples + s.samples_dropped, s.ticks);
 }
 

@@ -45,7 +45,8 @@ Session sample_session() {
   s.backend = "grid";
   s.overrides = {"material.friction=0.55"};
   s.trajectory.samples = {{0.0, Vec3(0.1, 0.2, 0.3), 0}, {0.001, Vec3(1.0 / 3.0, 0.2, 0.29), 1}};
-  s.forces = {{0.0, Vec3(0.0, 0.0, 0.0), 0.0}, {0.001, Vec3(0.1, -0.2, 2.5), 0.003}};
+  s.forces = {{0.0, Vec3(0.0, 0.0, 0.0), 0.0},
+              {0.001, Vec3(0.1, -0.2, 2.5), 0.003, Vec3(0.11, -0.21, 2.4), 1.0 / 3.0, Vec3(0.1, 1.0 / 7.0, -0.02)}};
   ToolSpec disk;
   disk.radius_m = 0.0213;
   disk.sides = 17;
@@ -80,6 +81,10 @@ TEST_F(Session_, RoundTripsBitForBit) {
   EXPECT_EQ(r.trajectory.samples[1].buttons, 1u);
   ASSERT_EQ(r.forces.size(), 2u);
   EXPECT_EQ(r.forces[1].force_n, s.forces[1].force_n);
+  EXPECT_EQ(r.forces[1].penetration_m, s.forces[1].penetration_m);
+  EXPECT_EQ(r.forces[1].model_force_n, s.forces[1].model_force_n);
+  EXPECT_EQ(r.forces[1].contact_fraction, s.forces[1].contact_fraction);
+  EXPECT_EQ(r.forces[1].model_velocity_m_s, s.forces[1].model_velocity_m_s);
   ASSERT_EQ(r.tools.size(), 3u);
   ASSERT_EQ(r.stamps.size(), 3u);
 
@@ -106,6 +111,27 @@ TEST_F(Session_, RoundTripsBitForBit) {
 
   // The session is also a replay file for --device replay:FILE.
   EXPECT_EQ(haptics::load_trajectory(file).samples.size(), 2u);
+}
+
+// Sessions recorded before the contact fraction and velocity (8 force columns), and before
+// the model's force (5), still read: the columns they lack are 0.
+TEST_F(Session_, ReadsTheOlderForceTables) {
+  const std::string rest =
+      "tool,shape,radius_m,size_x_m,size_y_m,sides,profile,sphere_radius_m,depth_m,rim_width_m,rim_forward_bias,"
+      "pour_volume_m3,polygon_m\n0,disk,0.02,0,0,32,flat,0,0.01,0.01,0.5,0,\n"
+      "stamp,t,x,y,bottom_z,heading_rad,dir_x,dir_y,tool\n";
+  const Session with_model = parse_session(
+      "t,fx,fy,fz,penetration_m,model_fx,model_fy,model_fz\n0.5,1,2,3,0.004,1.5,2.5,3.5\n" + rest, "old", "--replay");
+  ASSERT_EQ(with_model.forces.size(), 1u);
+  EXPECT_EQ(with_model.forces[0].force_n, Vec3(1.0, 2.0, 3.0));
+  EXPECT_EQ(with_model.forces[0].penetration_m, 0.004);
+  EXPECT_EQ(with_model.forces[0].model_force_n, Vec3(1.5, 2.5, 3.5));
+  EXPECT_EQ(with_model.forces[0].contact_fraction, 0.0);
+  EXPECT_EQ(with_model.forces[0].model_velocity_m_s, Vec3::Zero());
+  const Session oldest = parse_session("t,fx,fy,fz,penetration_m\n0.5,1,2,3,0.004\n" + rest, "old", "--replay");
+  ASSERT_EQ(oldest.forces.size(), 1u);
+  EXPECT_EQ(oldest.forces[0].penetration_m, 0.004);
+  EXPECT_EQ(oldest.forces[0].model_force_n, Vec3::Zero());
 }
 
 TEST_F(Session_, ToolIndexReusesIdenticalTools) {
@@ -204,6 +230,11 @@ TEST_F(Session_, RecordedStampsReplayExactly) {
   EXPECT_EQ(session.stamps.size(), totals.stamps);
   EXPECT_GT(session.trajectory.samples.size(), 500u);
   EXPECT_EQ(session.forces.size(), session.trajectory.samples.size());
+  // The drag (about 0.09 m/s): the model's velocity and contact fraction are recorded with its force.
+  bool moving_in_sand = false;
+  for (const SessionForce& f : session.forces)
+    moving_in_sand |= f.contact_fraction > 0.0 && f.model_velocity_m_s.head<2>().norm() > 0.05;
+  EXPECT_TRUE(moving_in_sand);
   EXPECT_EQ(session.backend, "grid");
 
   PreparedScene replay = prepared;
