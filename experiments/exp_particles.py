@@ -343,16 +343,49 @@ def run(ctx):
         cases.append(case)
     if not cases:
         return {"cases": [], "table": "", "figures": {}, "displacement": default, "compared": other,
-                "tool_force": "", "force_fit": {}, "summary": {}}
+                "tool_force": "", "force_fit": {}, "bars": "", "summary": {}}
     md = ctx.table("particles", ["case", "surface", "metric", "particles (mean ± sd over seeds)", *names], rows_csv)
     figures = {"sections": section_figure(ctx, cases, names), "difference": difference_figure(ctx, cases),
                "speed": speed_figure(ctx, cases, names)}
     out = values(cases, md, figures, other)
     sessions = {ref.case: model_forces(ctx, ref) for ref in refs if ref.forces}
-    out.update({"displacement": default, "compared": other, "tool_force": tool_force_table(ctx, refs, sessions),
+    out.update({"displacement": default, "compared": other, "bars": bars_table(ctx, cases, names),
+                "tool_force": tool_force_table(ctx, refs, sessions),
                 "force_fit": haptic_calibration.run(ctx, refs, sessions, {ref.case: force_parameters(ctx, scene_of(ref))
                                                                       for ref in refs})})
     return out
+
+
+# What a real-time earthmoving model is held to against the particles after the tool lifted
+# (Servin et al. 2021 report 10-25 % from DEM): header, metric keys, bar, and how the distance is
+# taken ("abs": largest absolute difference over the keys, in `scale` units; "rel": relative;
+# "value": the metric itself).
+BARS = [("trench floor, mm (bar 2)", ("floor_m",), 2e-3, "abs", 1e3),
+        ("berm / cut (bar 0.1)", ("berm_cut_ratio",), 0.1, "abs", 1.0),
+        ("pile ahead (bar 25 %)", ("ahead_height_m",), 0.25, "rel", 100.0),
+        ("side crests, mm (bar 1.5)", ("crest_left_m", "crest_right_m"), 1.5e-3, "abs", 1e3),
+        ("section RMSE, mm (bar 2)", ("section_rmse_m",), 2e-3, "value", 1e3)]
+
+
+def bars_table(ctx, cases, names):
+    """Each stroke case and model: its distance from the grains' mean on each bar, and whether the
+    bar holds."""
+    rows = []
+    for c in (c for c in cases if c["sections"] is not None):
+        dem = {k: float(np.mean([s[k] for s in c["dem_seeds"]])) for _, keys, _, _, _ in BARS for k in keys}
+        for label in names:
+            m = c["backends"][label]
+            row = [c["case"], label]
+            for _, keys, bar, how, scale in BARS:
+                if how == "value":
+                    d = m[keys[0]]
+                elif how == "rel":
+                    d = abs(m[keys[0]] - dem[keys[0]]) / abs(dem[keys[0]])
+                else:
+                    d = max(abs(m[k] - dem[k]) for k in keys)
+                row.append(f"{d * scale:.2g}{' %' if how == 'rel' else ''} {'yes' if d <= bar else 'no'}")
+            rows.append(row)
+    return ctx.table("particles_bars", ["case", "model"] + [b[0] for b in BARS], rows) if rows else ""
 
 
 def values(cases, table, figures, other):
