@@ -32,6 +32,7 @@
 #include "harness/interactive/stats.hpp"
 #include "harness/run/backends.hpp"
 #include "harness/run/variant.hpp"
+#include "harness/window/gl_driver.hpp"
 #include "harness/window/mouse.hpp"
 #include "harness/window/options.hpp"
 #include "harness/window/panel.hpp"
@@ -171,6 +172,7 @@ GLFWwindow* open_window(const InteractiveOptions& o, const std::string& title) {
     throw std::runtime_error("the window's OpenGL is " + std::to_string(epoxy_gl_version() / 10) + "." +
                              std::to_string(epoxy_gl_version() % 10) + "; OpenGL 3.3 is needed");
   }
+  keep_gl_driver_loaded();  // for LeakSanitizer at exit (gl_driver.hpp)
   return window;
 }
 
