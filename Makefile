@@ -10,7 +10,7 @@ FULL ?= 0
 
 FUZZ_SECONDS ?= 60
 
-.PHONY: all deps configure build test test-asan reproduce dem bench goldens fuzz format format-check lint clean
+.PHONY: all deps configure build test test-asan test-tsan reproduce dem bench goldens fuzz format format-check lint clean
 
 all: build
 
@@ -37,6 +37,14 @@ test-asan:
 	@LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
 		UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 		$(MAKE) --no-print-directory test PRESET=asan-ubsan
+
+# The haptics tests (servo loop, lock-free buffers, UDP device: the tests named Haptics*) under
+# ThreadSanitizer; only their test executable is built. A race report fails the run.
+test-tsan: deps
+	@cmake --preset tsan >/dev/null
+	@cmake --build build/tsan -j$(JOBS) --target sb_common_tests
+	@TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 \
+		ctest --test-dir build/tsan --output-on-failure -j$(JOBS) --timeout 900 -R '^Haptics' --no-tests=error
 
 # ENGINE=local (a pool of JOBS runs on this machine) or ENGINE=slurm (one job array through
 # sbatch; SLURM_PARTITION, SLURM_ACCOUNT, SLURM_TIME and SLURM_MEM per array task, at most

@@ -21,6 +21,10 @@ struct DeviceLimits {
   double max_force_n = 8.0;               // largest force magnitude the device may be sent
   double max_stiffness_n_per_m = 2000.0;  // largest spring constant it renders stably
   Aabb3 workspace;                        // reachable tool positions, world metres
+  // The fastest the tool can physically move (a hand on a desktop device). A pose that moved
+  // farther within one servo tick is a fault of the pose stream (dropped, reordered or corrupt
+  // packets), not motion: the servo restarts its rendering at the new pose (servo_core.hpp).
+  double max_speed_m_s = 2.0;
 };
 
 // One reading of the device. The position is the tool's lowest point (the bottom of its

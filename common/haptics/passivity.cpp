@@ -15,6 +15,10 @@ void PassivityController::observe(const Vec3& position) {
 }
 
 Vec3 PassivityController::control(const Vec3& force, const Vec3& velocity, double dt) {
+  return bound(damp(force, velocity, dt));
+}
+
+Vec3 PassivityController::damp(const Vec3& force, const Vec3& velocity, double dt) {
   active_now_ = false;
   const double predicted = energy_j_ + force.dot(velocity) * dt;
   const double v2 = velocity.squaredNorm();
@@ -26,6 +30,18 @@ Vec3 PassivityController::control(const Vec3& force, const Vec3& velocity, doubl
   ++active_;
   dissipated_j_ += size * speed * dt;
   return force - (size / speed) * velocity;
+}
+
+// The worst the next period can do: the force the device will send, times the longest step.
+Vec3 PassivityController::bound(const Vec3& force) {
+  bounded_now_ = false;
+  if (max_step_m_ <= 0.0) return force;
+  const double size = force.norm();
+  const double allowed = std::max(0.0, energy_bound_j() - energy_j_) / max_step_m_;
+  if (!(std::min(size, max_sent_n_) > allowed)) return force;
+  bounded_now_ = true;
+  ++bounded_;
+  return force * (allowed / size);
 }
 
 }  // namespace sb::haptics

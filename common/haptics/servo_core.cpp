@@ -16,7 +16,7 @@ ServoCore::ServoCore(HapticDevice& device, PatchBuffer& patches, double velocity
       rendering_(rendering),
       period_s_(period_s),
       blend_(rendering.blend_s),
-      passivity_(rendering.passivity_max_force_n),
+      passivity_(rendering.passivity_max_force_n, limits_.max_speed_m_s * period_s, limits_.max_force_n),
       coupling_(rendering.coupling_stiffness_n_per_m, rendering.coupling_damping_n_s_per_m, rendering.tool_mass_kg) {}
 
 ServoState ServoCore::step(double now_s) {
@@ -28,6 +28,12 @@ ServoState ServoCore::step(double now_s) {
   Vec3 force = Vec3::Zero();
   if (s.device.valid && s.device.position_m.allFinite()) {
     double dt = 0.0;
+    if (have_prev_ &&
+        (s.device.position_m - prev_position_).norm() > limits_.max_speed_m_s * std::max(0.0, now_s - prev_t_s_)) {
+      s.pose_jump = true;
+      restart_rendering();
+      have_prev_ = false;
+    }
     if (have_prev_ && now_s > prev_t_s_) {
       dt = now_s - prev_t_s_;
       const Vec3 raw = (s.device.position_m - prev_position_) / dt;
@@ -42,12 +48,8 @@ ServoState ServoCore::step(double now_s) {
   } else {
     // No pose: no force at once (not faded), and every rendering state starts afresh.
     have_prev_ = false;
-    velocity_.setZero();
     patches_.update();
-    blend_.reset();
-    coupling_.invalidate();
-    passivity_.lose_pose();
-    last_rendered_.setZero();
+    restart_rendering();
   }
   s.patch_version = patches_.front().version;
 
@@ -67,6 +69,14 @@ ServoState ServoCore::step(double now_s) {
   cmd.stale = !s.device.valid;
   device_.command_force(cmd);
   return s;
+}
+
+void ServoCore::restart_rendering() {
+  velocity_.setZero();
+  blend_.reset();
+  coupling_.invalidate();
+  passivity_.lose_pose();
+  last_rendered_.setZero();
 }
 
 // The rendering pipeline of rendering.hpp for a tick with a valid pose; dt: time since the
@@ -123,6 +133,7 @@ Vec3 ServoCore::render(ServoState& s, double dt) {
   if (rendering_.passivity) {
     f = passivity_.control(f, velocity_, period_s_);
     s.passivity_active = passivity_.active_now();
+    s.passivity_bounded = passivity_.bounded_now();
   }
   return f;
 }

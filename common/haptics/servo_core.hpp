@@ -1,5 +1,7 @@
 #pragma once
-// ServoCore: one servo tick without the clock -- read the device, estimate its velocity, take
+// ServoCore: one servo tick without the clock -- read the device, estimate its velocity (a
+// pose step faster than the device's max_speed_m_s restarts the rendering there, as a pose
+// lost and found again: it is not motion, so it moves no velocity estimate and books no work), take
 // the newest height patch, compute the force, render it (rendering.hpp: blend across patches,
 // optional virtual coupling, passivity control, force-rate limit), make it safe (finite,
 // within the device's force limit) and command it. ServoLoop calls it at 1 kHz; tests and
@@ -40,6 +42,8 @@ struct ServoState {
   bool patch_switched = false;            // a new patch arrived this tick
   bool rate_limited = false;              // the force-rate limit held the force back
   bool passivity_active = false;          // the passivity controller added damping
+  bool passivity_bounded = false;         // its energy bound scaled the force down
+  bool pose_jump = false;                 // the pose moved faster than the device's max_speed_m_s: rendering restarted
   double passivity_energy_j = 0.0;        // the observer's energy so far (> 0: energy created)
   double force_step_n = 0.0;              // |force - force of the previous tick|
   // Running counters of the loop (filled by ServoLoop).
@@ -64,6 +68,7 @@ class ServoCore {
 
  private:
   Vec3 render(ServoState& s, double dt);
+  void restart_rendering();  // no pose, or a pose jump: every rendering state starts afresh
 
   HapticDevice& device_;
   PatchBuffer& patches_;

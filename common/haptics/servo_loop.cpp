@@ -111,6 +111,7 @@ void ServoLoop::run() {
     }
     stats_.patch_switches += s.patch_switched;
     stats_.ticks_rate_limited += s.rate_limited;
+    stats_.pose_jumps += s.pose_jump;
     late_us_.add(duration<double, std::micro>(start - deadline).count());
     if (++rate_window_ticks, start - rate_window_start >= std::chrono::seconds(1)) {
       servo_hz = static_cast<double>(rate_window_ticks - 1) / duration<double>(start - rate_window_start).count();
@@ -147,6 +148,8 @@ void ServoLoop::run() {
   stats_.passivity_energy_max_j = pc.energy_max_j();
   stats_.passivity_dissipated_j = pc.dissipated_j();
   stats_.passivity_ticks_active = pc.active_ticks();
+  stats_.passivity_ticks_bounded = pc.bounded_ticks();
+  stats_.passivity_energy_bound_j = pc.energy_bound_j();
   stats_.servo_hz =
       stats_.ticks > 1 && stats_.duration_s > 0.0 ? static_cast<double>(stats_.ticks - 1) / stats_.duration_s : 0.0;
 }

@@ -60,6 +60,7 @@ struct ServoStats {
   // Continuity: |force(n) - force(n-1)| over all ticks (1 mN bins), and what shaped it.
   double force_step_n_p99 = 0.0, force_step_n_p999 = 0.0, force_step_n_max = 0.0;
   std::uint64_t patch_switches = 0, ticks_rate_limited = 0;
+  std::uint64_t pose_jumps = 0;  // poses that moved faster than the device's max_speed_m_s (servo_core.hpp)
   // Fidelity: |force sent - the model's force at the same pose| over the ticks with a pose
   // (1 mN bins), against the model with the patch blend (ServoState::model_force_n) and
   // without it (the model on the newest patch alone); both model forces are first passed
@@ -71,9 +72,10 @@ struct ServoStats {
   std::uint64_t onsets = 0;
   double onset_lag_ms_max = 0.0, onset_held_force_n = 0.0;
   // Passivity (passivity.hpp): the observer's energy at the end and at most (J, > 0: energy
-  // was created), the damping the controller added.
+  // was created), the damping the controller added, the energy bound and the ticks it acted.
   double passivity_energy_j = 0.0, passivity_energy_max_j = 0.0, passivity_dissipated_j = 0.0;
-  std::uint64_t passivity_ticks_active = 0;
+  double passivity_energy_bound_j = 0.0;
+  std::uint64_t passivity_ticks_active = 0, passivity_ticks_bounded = 0;
 };
 
 class ServoLoop {

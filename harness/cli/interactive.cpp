@@ -1,5 +1,6 @@
 // `sandbench interactive SCENE --backend tin|grid [--device mouse|replay:FILE|udp:PORT]
-//   [--record FILE] [--frames N --screenshot IMAGE.png --stats STATS.json] [--set k=v ...] [--unset k ...]`
+//   [--record FILE] [--frames N --screenshot IMAGE.png --stats STATS.json] [--set k=v ...] [--unset k ...]
+//   [--max-memory SIZE]`
 #include <memory>
 
 #include "harness/cli/commands.hpp"
@@ -33,6 +34,11 @@ void add_interactive_command(CLI::App& app) {
   cmd->add_option("--max-stiffness", o->max_stiffness_n_per_m, "Device stiffness limit, N/m")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-speed", o->max_speed_m_s,
+                  "Fastest the device's tool moves, m/s: a pose step beyond it is a fault of the pose stream, "
+                  "not motion (the force restarts from zero there and no work is booked)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--rate-hz", o->rate_hz, "Servo rate")->capture_default_str()->check(CLI::Range(100.0, 10000.0));
   cmd->add_option("--spin-us", o->spin_us, "Servo: spin this long before each deadline (at most one period)")
       ->capture_default_str()
@@ -46,6 +52,7 @@ void add_interactive_command(CLI::App& app) {
   cmd->callback([o, in, size] {
     o->scene = in->scene;
     o->overrides = scene_overrides(in->unset, in->overrides);
+    o->max_memory = in->max_memory;
     if (size->size() == 2) {
       o->width = (*size)[0];
       o->height = (*size)[1];

@@ -16,8 +16,8 @@ void add_scene_options(CLI::App* cmd, SceneInput& in, ReplayOption replay) {
     cmd->add_option("--replay", in.replay,
                     "Replay a session recorded by `sandbench interactive --record`: its stamps are the schedule "
                     "(on every back-end)");
-    add_max_memory_option(*cmd, in.max_memory);
   }
+  add_max_memory_option(*cmd, in.max_memory);
 }
 
 namespace {

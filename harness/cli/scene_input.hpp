@@ -1,7 +1,8 @@
 #pragma once
-// The scene a command works on, from its options: the positional SCENE, --set and --unset for
-// every command that takes a scene, and --replay and --max-memory for those that run a schedule
-// (`run`, `compare`). Defined here once, so the commands accept the same scene options.
+// The scene a command works on, from its options: the positional SCENE, --set, --unset and
+// --max-memory for every command that takes a scene (`run`, `compare`, `interactive`), and
+// --replay for those that run a schedule (`run`, `compare`). Defined here once, so the commands
+// accept the same scene options.
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <optional>
@@ -23,7 +24,7 @@ struct SceneInput {
 
 enum class ReplayOption { Without, With };
 
-// Adds SCENE, --set and --unset (and --replay and --max-memory with ReplayOption::With) to CMD,
+// Adds SCENE, --set, --unset and --max-memory (and --replay with ReplayOption::With) to CMD,
 // filling IN.
 void add_scene_options(CLI::App* cmd, SceneInput& in, ReplayOption replay);
 

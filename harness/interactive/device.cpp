@@ -35,14 +35,17 @@ DeviceSpec parse_device_spec(const std::string& text) {
   return s;
 }
 
-haptics::DeviceLimits scene_device_limits(const HeightField& initial, double max_force_n,
-                                          double max_stiffness_n_per_m) {
+haptics::DeviceLimits scene_device_limits(const HeightField& initial, double max_force_n, double max_stiffness_n_per_m,
+                                          double max_speed_m_s) {
   if (!(max_force_n > 0.0) || !std::isfinite(max_force_n))
     throw InputError("--max-force-n " + std::to_string(max_force_n) + " must be a finite number > 0");
   if (!(max_stiffness_n_per_m > 0.0) || !std::isfinite(max_stiffness_n_per_m))
     throw InputError("--max-stiffness " + std::to_string(max_stiffness_n_per_m) + " must be a finite number > 0");
+  if (!(max_speed_m_s > 0.0) || !std::isfinite(max_speed_m_s))
+    throw InputError("--max-speed " + std::to_string(max_speed_m_s) + " must be a finite number > 0");
   haptics::DeviceLimits l;
   l.max_force_n = max_force_n;
+  l.max_speed_m_s = max_speed_m_s;
   l.max_stiffness_n_per_m = max_stiffness_n_per_m;
   const Aabb2 box = initial.domain().box();
   double zlo = 1e300, zhi = -1e300;

@@ -20,10 +20,11 @@ struct DeviceSpec {
 // Throws InputError naming --device.
 DeviceSpec parse_device_spec(const std::string& text);
 
-// Limits for a scene: the given force and stiffness limits, and a workspace covering the
+// Limits for a scene: the given force, stiffness and speed limits, and a workspace covering the
 // domain (plus 5 cm) from 10 cm below the lowest initial surface to 10 cm above the highest.
-// Throws InputError naming --max-force-n / --max-stiffness for non-positive values.
-haptics::DeviceLimits scene_device_limits(const HeightField& initial, double max_force_n, double max_stiffness_n_per_m);
+// Throws InputError naming --max-force-n / --max-stiffness / --max-speed for non-positive values.
+haptics::DeviceLimits scene_device_limits(const HeightField& initial, double max_force_n, double max_stiffness_n_per_m,
+                                          double max_speed_m_s = haptics::DeviceLimits{}.max_speed_m_s);
 
 // Loads the replay file or binds the UDP port (InputError naming --device on failure).
 std::unique_ptr<haptics::HapticDevice> make_device(const DeviceSpec& spec, const haptics::DeviceLimits& limits);

@@ -20,6 +20,7 @@ Json haptic_stats_json(const haptics::ServoStats& s, const haptics::DeviceLimits
   // Extras beyond the contract.
   j["force_limit_n"] = limits.max_force_n;
   j["stiffness_limit_n_per_m"] = limits.max_stiffness_n_per_m;
+  j["speed_limit_m_s"] = limits.max_speed_m_s;
   j["device_force_max_n"] = info.device_force_max_n;
   j["forces_clamped"] = s.forces_clamped;
   j["forces_nonfinite"] = s.forces_nonfinite;
@@ -39,6 +40,7 @@ Json haptic_stats_json(const haptics::ServoStats& s, const haptics::DeviceLimits
   j["force_step_n.max"] = s.force_step_n_max;
   j["patch_switches"] = s.patch_switches;
   j["ticks_rate_limited"] = s.ticks_rate_limited;
+  j["pose_jumps"] = s.pose_jumps;
   // Fidelity: the force sent against the model's force at the same pose (servo_loop.hpp).
   j["force_error_n.p50"] = s.force_error_n_p50;
   j["force_error_n.p99"] = s.force_error_n_p99;
@@ -53,6 +55,8 @@ Json haptic_stats_json(const haptics::ServoStats& s, const haptics::DeviceLimits
   j["passivity.energy_max_j"] = s.passivity_energy_max_j;
   j["passivity.dissipated_j"] = s.passivity_dissipated_j;
   j["passivity.ticks_active"] = s.passivity_ticks_active;
+  j["passivity.energy_bound_j"] = s.passivity_energy_bound_j;
+  j["passivity.ticks_bounded"] = s.passivity_ticks_bounded;
   j["sim.steps"] = sim.steps;
   j["sim.stamps"] = sim.stamps;
   j["sim.step_ms.p50"] = percentile(sim.step_ms, 0.5);

@@ -31,7 +31,9 @@
 #include "harness/interactive/device.hpp"
 #include "harness/interactive/stats.hpp"
 #include "harness/run/backends.hpp"
+#include "harness/run/preflight.hpp"
 #include "harness/run/variant.hpp"
+#include "harness/window/gl_driver.hpp"
 #include "harness/window/mouse.hpp"
 #include "harness/window/options.hpp"
 #include "harness/window/panel.hpp"
@@ -119,7 +121,8 @@ struct GlfwSession {
 
 // Everything that can be wrong with the input, checked before a window opens: the options
 // one by one by CLI11 (harness/cli/interactive.cpp), here what they say together; then the
-// device (which reads a replay file), a display to open a window on, and the model.
+// scene and its resource pre-flight, the device (which reads a replay file), a display to open a
+// window on, and the model.
 struct InteractiveSetup {
   Variant variant;
   PreparedScene prepared;
@@ -139,9 +142,15 @@ InteractiveSetup prepare_interactive(const InteractiveOptions& o) {
   Variant variant = parse_variant(o.backend, "--backend");
   std::vector<std::string> overrides = o.overrides;
   overrides.insert(overrides.end(), variant.overrides.begin(), variant.overrides.end());
-  PreparedScene prepared = prepare_scene(load_scene(o.scene, overrides));
+  Scene scene = load_scene(o.scene, overrides);
+  // Before the model is allocated, as `run` does: the device takes the tool anywhere in the
+  // domain for as long as the window is open, so the whole domain counts as disturbed (as for a
+  // replayed session); the window keeps no step records.
+  preflight(estimate_resources({{variant.backend, scene}}, 0, /*replay=*/true), o.max_memory);
+  PreparedScene prepared = prepare_scene(std::move(scene));
   const DeviceSpec device_spec = parse_device_spec(o.device);
-  const haptics::DeviceLimits limits = scene_device_limits(prepared.initial, o.max_force_n, o.max_stiffness_n_per_m);
+  const haptics::DeviceLimits limits =
+      scene_device_limits(prepared.initial, o.max_force_n, o.max_stiffness_n_per_m, o.max_speed_m_s);
   std::unique_ptr<haptics::HapticDevice> device = make_device(device_spec, limits);
   const char* x11 = std::getenv("DISPLAY");
   const char* wayland = std::getenv("WAYLAND_DISPLAY");
@@ -171,6 +180,7 @@ GLFWwindow* open_window(const InteractiveOptions& o, const std::string& title) {
     throw std::runtime_error("the window's OpenGL is " + std::to_string(epoxy_gl_version() / 10) + "." +
                              std::to_string(epoxy_gl_version() % 10) + "; OpenGL 3.3 is needed");
   }
+  keep_gl_driver_loaded();  // for LeakSanitizer at exit (gl_driver.hpp)
   return window;
 }
 

@@ -227,6 +227,29 @@ TEST_F(StrictInputs, ARunLargerThanMaxMemoryIsRefusedUpFrontNamingTheKeys) {
   EXPECT_TRUE(contains(r.out, "--max-memory")) << r.out;
 }
 
+TEST_F(StrictInputs, InteractiveRefusesAModelLargerThanMaxMemoryBeforeAnyWindow) {
+  // The same pre-flight as `run`, before the model (and the window, or even the display, is
+  // looked for): the display variables are unset, so only the pre-flight can give this answer.
+  const std::string interactive = "env -u DISPLAY -u WAYLAND_DISPLAY " + std::string(SB_CLI_PATH) + " interactive ";
+  CliResult r = sb::test::run_shell(interactive + shipped_scene("pile.toml") +
+                                    " --backend grid --set grid.cell_m=1e-5 --max-memory 4G --frames 1 2>&1");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_TRUE(contains(r.out, "more than --max-memory (4.00 GiB)")) << r.out;
+  EXPECT_TRUE(contains(r.out, "grid.cell_m, domain.size_m: [grid] grid nodes, 9e+08")) << r.out;
+  // The device may take the tool anywhere: a TIN counts its refinement over the whole domain.
+  r = sb::test::run_shell(interactive + shipped_scene("flat_stroke.toml") +
+                          " --backend tin --set tin.refine_m=1e-6 --max-memory 1G --frames 1 2>&1");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_TRUE(contains(r.out, "tin.refine_m: [tin] TIN vertices refined over the disturbed area")) << r.out;
+  // Within the limit, the next check speaks (no display), and a bad limit is the option's error.
+  r = sb::test::run_shell(interactive + shipped_scene("pile.toml") + " --backend grid --max-memory 4G --frames 1 2>&1");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_TRUE(contains(r.out, "xvfb-run")) << r.out;
+  r = sb::test::run_shell(interactive + shipped_scene("pile.toml") + " --backend grid --max-memory 1X --frames 1 2>&1");
+  EXPECT_EQ(r.code, 2) << r.out;
+  EXPECT_TRUE(contains(r.out, "--max-memory")) << r.out;
+}
+
 TEST_F(StrictInputs, AHugeHeightmapIsRefusedNamingTerrainPath) {
   // A valid 20000 x 20000 16-bit PNG of zeros (about 800 kB), written row by row.
   const fs::path png = dir_ / "huge.png";
