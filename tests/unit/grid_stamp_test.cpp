@@ -184,7 +184,7 @@ TYPED_TEST(GridStamp, ToolAboveTheSurfaceCutsNothing) {
 }
 
 TYPED_TEST(GridStamp, PourAddsExactlyItsVolume) {
-  const Scene s = rim_scene({}, flat_scene("shape = \"pour\"\nradius_m = 0.02\nvolume_m3 = 1e-4\n"));
+  const Scene s = scene({}, flat_scene("shape = \"pour\"\nradius_m = 0.02\nvolume_m3 = 1e-4\n"));
   const auto t = make_grid<TypeParam>(s);
   double expected = t->volume();
   // Inside, at the border, outside the domain, and narrower than a cell.
@@ -210,7 +210,7 @@ TYPED_TEST(GridStamp, PourAddsExactlyItsVolume) {
 // highest at the node nearest to it. (Spread evenly over the nodes within the radius, these
 // pours landed centred 0.2 to 1.7 mm off their points on this 5 mm grid.)
 TYPED_TEST(GridStamp, APourLandsCentredOnItsPoint) {
-  const Scene s = rim_scene({}, flat_scene("shape = \"pour\"\nradius_m = 0.02\nvolume_m3 = 1e-4\n"));
+  const Scene s = scene({}, flat_scene("shape = \"pour\"\nradius_m = 0.02\nvolume_m3 = 1e-4\n"));
   for (const auto& [xy, radius] : std::vector<std::pair<Vec2, double>>{
            {{0.25, 0.25}, 0.02}, {{0.2512, 0.2471}, 0.02}, {{0.1234, 0.3456}, 0.0123}, {{0.3011, 0.1987}, 0.001}}) {
     const auto t = make_grid<TypeParam>(s);
