@@ -406,7 +406,7 @@ def values(cases, table, figures, other):
                          "other_rmse_mm": {b: c["backends"][f"{b} {other}"]["section_rmse_m"] * 1e3 for b in BACKENDS},
                          "verdict": ("the shared tool model: the back-ends agree far better with each other "
                                      "than with the grains" if shared else
-                                     "partly the discretisation (the back-ends differ by a sizeable part of it)")})
+                                     "partly the discretisation (back-ends differ by much of it)")})
             for b in BACKENDS:  # the report's summary table joins the cases' cells
                 summary.setdefault(b, {}).setdefault("accuracy vs particle sand", [])
                 summary[b]["accuracy vs particle sand"].append(f"{c['case']} {rmse[b] * 1e3:.1f} mm")
