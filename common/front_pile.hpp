@@ -14,14 +14,14 @@
 // The sand already ahead (the pile of the earlier stamps, carried with the tool because each
 // stamp cuts its back part again) counts as terrain, so the pile grows with the cut and runs out
 // ahead at the angle of repose within the stamp, where a band of fixed width ahead made it a
-// column that erosion had to take down over many steps (0.18 m on a 15 mm cut). Erosion spills
+// column that erosion had to take down over many steps. Erosion spills
 // the corridor's sides, which the moving tool leaves behind as side berms. Each back-end collects
 // its nodes or vertices as samples, asks for the level and deposits in proportion to the depths;
 // the stamp normalises the deposit, so the volume stays exact.
 //
 // (The particles carry the pile's flanks beside the blade with them; a pile filled beside the
 // front half of the tool too, or around the blade's corners, left those flanks behind as berms
-// three to four times the particles'. Carrying them needs state between stamps, which this
+// several times the particles'. Carrying them needs state between stamps, which this
 // model does not keep: results/particles.md shows what the corridor costs.)
 #include <vector>
 

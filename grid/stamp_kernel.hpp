@@ -64,16 +64,17 @@ inline std::vector<Deposit> widened_rim(const GridLayout& layout, const ToolStam
 // The nodes of a bulldozing stamp's front pile (common/front_pile.hpp), each weighted by its
 // depth under the pile. The region sampled starts at the pile's reach on flat ground and widens
 // until it holds every node the pile covers (the pile carried from earlier stamps raises the
-// level: a round or two more). Empty when no node lies ahead of the tool.
+// level: a round or two more) or the corridor runs off the grid. Empty when no node lies ahead
+// of the tool.
 template <class Store>
 std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, double volume) {
   const GridLayout& layout = grid.layout();
   const double tan = s.rim.tan_repose;
   const Aabb2 footprint_box = bounds(s.footprint);
-  const Aabb2 grid_box = layout.box();
   double reach = std::max({front_pile_flat_reach(volume, 2.0 * s.half_width_m, tan), s.rim.width_m, layout.diagonal()});
   std::vector<std::uint32_t> nodes;
   std::vector<PileSample> samples;
+  std::size_t sampled_before = 0;
   // Each round at least 1.5 times wider: 64 outgrow any domain; the bound guards non-finite input.
   for (int round = 0; round < 64; ++round) {
     nodes.clear();
@@ -96,8 +97,11 @@ std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, dou
     if (samples.empty()) return {};
     const double level = front_pile_level(samples, volume, tan);
     const double needed = front_pile_reach_needed(level, lowest, tan);
-    const bool covers_grid = window.contains(grid_box.lo) && window.contains(grid_box.hi);
-    if (needed <= reach || covers_grid || !std::isfinite(needed)) {
+    // No node gained since the last round: the corridor runs off the grid, and a wider window
+    // would only rescan it (up to the whole grid, every stamp, with a pile against the border).
+    const bool off_grid = nodes.size() == sampled_before;
+    sampled_before = nodes.size();
+    if (needed <= reach || off_grid || !std::isfinite(needed)) {
       std::vector<Deposit> pile;
       for (std::size_t i = 0; i < nodes.size(); ++i)
         if (const double depth = front_pile_depth(samples[i], level, tan); depth > 0.0)

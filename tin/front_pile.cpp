@@ -59,6 +59,7 @@ bool TinTerrain::deposit_front_pile(StampWork& w, double deposit, StampReport& r
   std::vector<VertexHandle> found, pile;
   std::vector<PileSample> samples;
   double level = 0.0;
+  std::size_t sampled_before = 0;
   // Each round at least 1.5 times wider: 64 outgrow any domain; the bound guards non-finite input.
   for (int round = 0; round < 64; ++round) {
     fill_pile_lattice(w, reach, report);
@@ -79,8 +80,10 @@ bool TinTerrain::deposit_front_pile(StampWork& w, double deposit, StampReport& r
     if (samples.empty()) return false;
     level = front_pile_level(samples, deposit, tan);
     const double needed = front_pile_reach_needed(level, lowest, tan);
-    const bool covers_domain = window.contains(box_.lo) && window.contains(box_.hi);
-    if (needed <= reach || covers_domain || !std::isfinite(needed)) break;
+    // No vertex gained since the last round: the corridor runs off the domain (as on the grid).
+    const bool off_domain = pile.size() == sampled_before;
+    sampled_before = pile.size();
+    if (needed <= reach || off_domain || !std::isfinite(needed)) break;
     reach = std::max(1.1 * needed, 1.5 * reach);
   }
   double weight_sum = 0.0;

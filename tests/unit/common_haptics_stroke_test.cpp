@@ -209,8 +209,8 @@ TEST(HapticsStroke, ReplayedStrokeIsContinuousPassiveAndStillPushesBackOnEveryBa
     EXPECT_GT(raw_max, 0.5);
     // The sand still pushes back: steady contact force within 15% of the raw model's. (The
     // rendering blends each patch in over blend_ms, so the tool meets the bulldozed pile ahead
-    // of it on a patch up to that old, before the next stamp has cut it: the rendered force is
-    // 9-13% above the raw model's under tool.displacement = "bulldoze", within 10% under "rim".)
+    // of it on a patch up to that old, before the next stamp has cut it: the rendered force sits
+    // above the raw model's by more under tool.displacement = "bulldoze" than under "rim".)
     ASSERT_GT(r.steady_n.size(), 1000u);
     const double steady = percentile(r.steady_n, 0.5), steady_raw = percentile(before.steady_n, 0.5);
     EXPECT_GT(steady, 2.0);

@@ -2,7 +2,7 @@
 // a box blade dragged through flat sand on several headings carries its cut sand ahead as a pile
 // at the angle of repose. Checked after every stamp, before erosion: volume to rounding, the
 // mesh's integrity, the pile never steeper than the repose slope along the motion (it stood as a
-// column of 12 times the cut depth when the sand went to a band of fixed width), nothing raised
+// column many times the cut depth when the sand went to a band of fixed width), nothing raised
 // behind the stroke's start; and the pile the same on every heading.
 #include <gtest/gtest.h>
 
@@ -94,8 +94,7 @@ TYPED_TEST(Bulldoze, CarriesAPileAtReposeOnEveryHeading) {
     const auto out = this->drag(start, heading);
     // The fall ahead of the blade: the repose slope (to a degree), after every stamp.
     EXPECT_LE(out.steepest_ahead, std::tan(31.0 * std::numbers::pi / 180.0)) << heading;
-    // The pile: taller than the cut is deep (sand is carried), far below the former column
-    // (0.18 m on the particles' box blade).
+    // The pile: taller than the cut is deep (sand is carried), far below the former column.
     EXPECT_GT(out.pile_height_m, 2.0 * kDepth) << heading;
     EXPECT_LT(out.pile_height_m, 4.0 * kDepth) << heading;
     heights.push_back(out.pile_height_m);
