@@ -88,6 +88,7 @@ Json haptic_stats_json(const haptics::ServoStats& s, const haptics::DeviceLimits
   j["stamp_to_frame_ms.p95"] = percentile(info.stamp_to_frame_ms, 0.95);
   j["backend"] = info.backend;
   j["device"] = info.device;
+  j["gl_renderer"] = info.gl_renderer;
   j["scene"] = info.scene;
   return j;
 }

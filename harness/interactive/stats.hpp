@@ -14,6 +14,7 @@ namespace sb {
 
 struct InteractiveRunInfo {
   std::string scene, backend, device;
+  std::string gl_renderer;  // GL_RENDERER of the window's context (e.g. llvmpipe under Xvfb)
   std::uint64_t frames = 0;
   double wall_s = 0.0;                    // window open time
   double device_force_max_n = -1.0;       // as the device saw it (replay, mouse); < 0: unknown

@@ -264,6 +264,7 @@ class WindowLoop {
     info.scene = o_.scene;
     info.backend = setup_.variant.label;
     info.device = o_.device;
+    if (const auto* r = glGetString(GL_RENDERER)) info.gl_renderer = reinterpret_cast<const char*>(r);
     info.frames = static_cast<std::uint64_t>(frames_);
     info.wall_s = wall_s_;
     info.frame_ms = frame_ms_;

@@ -76,6 +76,8 @@ void expect_safe_forces(const nlohmann::json& s) {
   EXPECT_LE(s["force_max_n"].get<double>(), limit);
   EXPECT_LE(s["device_force_max_n"].get<double>(), limit);
   EXPECT_GT(s["ticks"].get<double>(), 0.0);
+  // The renderer the frame figures were measured on (llvmpipe under Xvfb).
+  EXPECT_FALSE(s.value("gl_renderer", std::string()).empty());
 }
 
 class Window : public ::testing::Test {
