@@ -94,9 +94,21 @@ def read_session(session):
 
 def _run_interactive(sandbench, backend, recording, session, stats, overrides, scene=SCENE):
     frames = int(math.ceil((replay_duration(recording) + 1.0) * FRAMES_PER_S))
-    cmd = ["xvfb-run", "-a", "-s", "-screen 0 1024x768x24", str(sandbench), "interactive", str(scene),
-           "--backend", backend, "--device", f"replay:{recording}", "--frames", str(frames),
-           "--record", str(session), "--stats", str(stats), "--size", "640", "400"]
+    run_interactive(sandbench, scene, backend, recording, stats, overrides, frames, session=session)
+
+
+def run_interactive(sandbench, scene, backend, recording, stats, overrides=(), frames=200, size=(640, 400),
+                    session=None):
+    """One `sandbench interactive` run replaying RECORDING in a window of SIZE (width, height) under xvfb-run
+    (its screen at least 1024 x 768 and the window's size): FRAMES frames, the stats JSON to STATS and, when
+    SESSION is given, the session recorded there. Raises with the command's stderr when it fails."""
+    width, height = size
+    screen = f"-screen 0 {max(width, 1024)}x{max(height, 768)}x24"
+    cmd = ["xvfb-run", "-a", "-s", screen, str(sandbench), "interactive", str(scene), "--backend", backend,
+           "--device", f"replay:{recording}", "--frames", str(frames), "--stats", str(stats),
+           "--size", str(width), str(height)]
+    if session is not None:
+        cmd += ["--record", str(session)]
     for o in overrides:
         cmd += ["--set", o]
     proc = subprocess.run(cmd, capture_output=True, text=True)

@@ -8,8 +8,10 @@ step in the force comes from the rendering, not from the motion. The plunge's pe
 
   haptics_trajectory.py OUT.csv [--surface-z 0.1] [--above-mm 3] [--depth-mm 10] [--plunge-s 0.122]
                         [--hold-s 0.4] [--heading-deg 45] [--stroke-m 0.1] [--stroke-s 1.5] [--rate-hz 1000]
+                        [--centre X Y] [--wait-s 0.2]
 
-The defaults are flat_stroke.toml's: sand 0.1 m high, the stroke centred on the domain's centre.
+The defaults are flat_stroke.toml's: sand 0.1 m high, the stroke centred on the domain's centre (--centre
+0.5 0.5 for its sand on a 1 m square, `--set 'domain.size_m=[1.0,1.0]'`).
 """
 import argparse
 import math
@@ -26,14 +28,14 @@ def min_jerk(s):
 
 
 def trajectory(surface_z=0.1, above_mm=3.0, depth_mm=10.0, plunge_s=0.122, hold_s=0.4, heading_deg=45.0,
-               stroke_m=0.1, stroke_s=1.5, rate_hz=1000.0, centre=CENTRE):
-    """Rows (t, x, y, z, buttons): wait, plunge, hold, stroke, hold, lift, wait."""
+               stroke_m=0.1, stroke_s=1.5, rate_hz=1000.0, centre=CENTRE, wait_s=0.2):
+    """Rows (t, x, y, z, buttons): wait (wait_s), plunge, hold, stroke, hold, lift, wait (0.2 s)."""
     h = math.radians(heading_deg)
     d = (math.cos(h), math.sin(h))
     x0 = (centre[0] - 0.5 * stroke_m * d[0], centre[1] - 0.5 * stroke_m * d[1])
     z_top, z_bottom = surface_z + 1e-3 * above_mm, surface_z - 1e-3 * depth_mm
     wait, lift_s = 0.2, plunge_s
-    phases = [wait, plunge_s, hold_s, stroke_s, hold_s, lift_s, wait]
+    phases = [wait_s, plunge_s, hold_s, stroke_s, hold_s, lift_s, wait]
     ends = [sum(phases[:i + 1]) for i in range(len(phases))]
     rows = []
     n = int(round(ends[-1] * rate_hz))
@@ -68,13 +70,19 @@ def main(argv):
     ap.add_argument("--stroke-m", type=float, default=0.1)
     ap.add_argument("--stroke-s", type=float, default=1.5)
     ap.add_argument("--rate-hz", type=float, default=1000.0)
+    ap.add_argument("--centre", type=float, nargs=2, default=CENTRE, metavar=("X", "Y"),
+                    help="the stroke's centre, m (default: flat_stroke.toml's domain centre)")
+    ap.add_argument("--wait-s", type=float, default=0.2, help="time above the sand before the plunge")
     a = ap.parse_args(argv)
-    for name in ("plunge_s", "hold_s", "stroke_s", "rate_hz"):
+    for name in ("plunge_s", "hold_s", "stroke_s", "rate_hz", "wait_s"):
         if not getattr(a, name) > 0.0:
             print(f"--{name.replace('_', '-')} must be > 0 (got {getattr(a, name)})", file=sys.stderr)
             return 2
+    if not all(math.isfinite(c) for c in a.centre):
+        print(f"--centre must be finite (got {a.centre[0]} {a.centre[1]})", file=sys.stderr)
+        return 2
     rows = trajectory(a.surface_z, a.above_mm, a.depth_mm, a.plunge_s, a.hold_s, a.heading_deg, a.stroke_m,
-                      a.stroke_s, a.rate_hz)
+                      a.stroke_s, a.rate_hz, tuple(a.centre), a.wait_s)
     write(Path(a.out), rows)
     return 0
 

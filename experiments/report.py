@@ -33,7 +33,8 @@ PARTS = [
     ("Settling", "How does the time to come to rest grow with resolution, and what does the cascade cost?",
      ["settling", "cascade"]),
     ("Stability and cliffs", "Does any input crash a back-end or make its cost explode?", ["stability", "cliffs"]),
-    ("Haptics", "What force does the hand feel on each back-end?", ["haptics"]),
+    ("Interactive use", "What force does the hand feel on each back-end, and does the window keep up as the "
+     "domain grows?", ["haptics", "interactive_scaling"]),
     ("The sparse grid", "Does a sparse grid keep the paper's memory promise without the TIN's costs?", ["sparse"]),
 ]
 

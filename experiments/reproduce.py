@@ -30,6 +30,7 @@ import exp_fig5_6
 import exp_fig7
 import exp_fig8_9
 import exp_haptics
+import exp_interactive_scaling
 import exp_memory
 import exp_orientation
 import exp_particles
@@ -58,6 +59,7 @@ EXPERIMENTS = {
     "cliffs": exp_cliffs,
     "bars": exp_bars,
     "haptics": exp_haptics,
+    "interactive_scaling": exp_interactive_scaling,
 }
 
 

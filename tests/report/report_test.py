@@ -59,6 +59,68 @@ class Summary(unittest.TestCase):
         self.assertEqual(report.summary_table({"a": {}}), "")
 
 
+class InteractiveScaling(unittest.TestCase):
+    """exp_interactive_scaling's path from stats JSON to table, bars and section, on made-up stats (the replays
+    themselves run in the smoke test's tiny profile)."""
+
+    @staticmethod
+    def stats(fps, step_p95, latency_p95, cells=40401, vertices=0, stamps=23):
+        return {"fps": fps, "frame_ms.p50": 1e3 / fps, "frame_ms.p99": 2e3 / fps, "stamp_to_frame_ms.p50": 0.5 *
+                latency_p95, "stamp_to_frame_ms.p95": latency_p95, "sim.step_ms.p50": 0.1, "sim.step_ms.p95": step_p95,
+                "display_ms.p95": 0.1, "upload_ms.p95": 0.2, "sim.stamps": stamps, "sim.steps": 400, "cells": cells,
+                "vertices": vertices}
+
+    def test_cases_span_the_sizes_and_tiny_runs_one(self):
+        import exp_interactive_scaling as x
+        self.assertEqual(x.cases("tiny"), [("grid", 1.0, 0.01)])
+        paper = x.cases("paper")
+        self.assertIn(("grid",) + x.FINE, paper)
+        self.assertIn(("sparse",) + x.COARSE, paper)
+        self.assertIn(("grid",) + x.LARGE, paper)
+        self.assertEqual([c for c in paper if c[0] == "tin"], [("tin", 1.0, None), ("tin", 2.0475, None)])
+        self.assertEqual(x.overrides(("grid", 1.0, 0.001)), ["domain.size_m=[1.0, 1.0]", "grid.cell_m=0.001"])
+
+    def test_bars_table_and_section(self):
+        import csv
+        import tempfile
+        import types
+        import exp_interactive_scaling as x
+        import sbrun
+        made = {("grid", 1.0, 0.005): self.stats(20.0, 0.1, 40.0), ("grid", 1.0, 0.001): self.stats(20.0, 0.2, 60.0),
+                ("grid", 2.0475, 0.0005): self.stats(14.0, 3.0, 90.0, cells=4096 ** 2),
+                ("tin", 1.0, None): self.stats(50.0, 1.0, 30.0, cells=0, vertices=900, stamps=0)}
+        rows = {c: x.figures(c, s) for c, s in made.items()}
+        self.assertEqual(rows[("tin", 1.0, None)]["elements"], 900)
+        self.assertNotEqual(rows[("tin", 1.0, None)]["latency_p95"], rows[("tin", 1.0, None)]["latency_p95"],
+                            "no stamp, no latency (NaN)")
+        bars = {(b["bar"], b["backend"]): b["verdict"] for b in x.judge(rows)}
+        self.assertEqual(bars[("fps 1 mm / 5 mm", "grid")], "met")  # 1.0 against 0.8
+        self.assertEqual(bars[("sim step p95 1 mm / 5 mm", "grid")], "missed")  # 2.0
+        self.assertEqual(bars[("stamp to frame p95 at 1 mm", "grid")], "missed")
+        self.assertEqual(bars[("fps at 4096 x 4096", "grid")], "missed (within 10%)")  # 14 against 15
+        self.assertEqual(bars[("stamp to frame p95 at 4096 x 4096", "grid")], "met (within 10%)")
+        self.assertEqual(len(bars), 5, "no sparse rows, no sparse bars")
+        self.assertEqual(x.renderer_of(made.values()), "unknown")
+        self.assertEqual(x.renderer_of([{"gl_renderer": "llvmpipe (LLVM 15.0.6, 256 bits)"}]),
+                         "llvmpipe (LLVM 15.0.6, 256 bits)")
+        with tempfile.TemporaryDirectory() as tmp:
+            ctx = types.SimpleNamespace(results=Path(tmp), table=lambda *a: sbrun.Context.table(ctx, *a),
+                                        figure=lambda fig, name: sbrun.Context.figure(ctx, fig, name))
+            sbrun.env_ok()
+            values = x.values(ctx, rows, "llvmpipe")
+            with open(Path(tmp) / "interactive_scaling.csv") as f:
+                table = list(csv.DictReader(f))
+            self.assertEqual([r["back-end"] for r in table], ["grid", "grid", "grid", "tin"])
+            self.assertEqual(float(table[1]["fps"]), 20.0)
+            self.assertEqual(int(table[2]["elements"]), 4096 ** 2)
+            self.assertTrue((Path(tmp) / values["png"]).stat().st_size > 0)
+        text = report.render("interactive_scaling", values)
+        self.assertIn("**Verdict.**", text)
+        self.assertIn("**Method or code:**", text)
+        self.assertIn("llvmpipe", text)
+        self.assertIn("Skipped: no display", report.render("interactive_scaling", {"skipped": "no display"}))
+
+
 class Words(unittest.TestCase):
     def test_prose_only(self):
         text = ("# Title here\n\nTwo words.\n\n| a | b |\n|---|---|\n| 1 | 2 |\n\n![fig](x.png)\n\n"

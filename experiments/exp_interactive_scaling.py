@@ -1,0 +1,262 @@
+#!/usr/bin/python3
+"""Interactive scaling: frame rate, stamp-to-frame latency and simulation step against domain size, every
+back-end, in a 1280 x 720 window under xvfb-run.
+
+One plunge-and-stroke (haptics_trajectory.py: wait 3 mm above the sand, plunge 1 cm in, stroke 0.1 m along the
+diagonal, lift), centred on the domain, is replayed through `sandbench interactive` on flat_stroke.toml's sand
+over square domains of 1 m (cells of 10, 5, 2 and 1 mm: 1e4 to 1e6 grid nodes) and 2.0475 m at 0.5 mm (4096 x
+4096 nodes); the TIN on the same domains, its element count its vertex count at the end (the stats'). Each run
+draws FRAMES frames and its --stats JSON gives every figure; the renderer is the stats' `gl_renderer`
+(glGetString(GL_RENDERER)), "unknown" from a binary that does not write it. Beside the replays, `sandbench run`
+strokes the same path at 5 and 1 mm: what its stamps touch and what they and their erosion cost, without a window.
+
+The bars on the 1 m replay: grid and sparse at 1 mm at least 0.8 x their frame rate at 5 mm, a sim step
+p95 within 1.5 x of the 5 mm run's and a stamp-to-frame p95 of at most 50 ms; the 4096 x 4096 grid at least 15 fps
+and each stamp shown within 100 ms. The tiny profile runs the smallest grid case only.
+
+One case by hand (the trajectory: haptics_trajectory.py TRAJ --centre 0.5 0.5 --wait-s 1.5 --hold-s 0.2 --stroke-s 1):
+  xvfb-run -a -s '-screen 0 1280x768x24' sandbench interactive experiments/scenes/flat_stroke.toml --backend B
+    --set 'domain.size_m=[1.0,1.0]' --set grid.cell_m=C --device replay:TRAJ --frames 200 --size 1280 720 --stats S
+"""
+import shutil
+
+import exp_haptics
+import haptics_trajectory
+import sbrun
+
+SCENE = sbrun.DIAGONAL_SCENE
+BACKENDS = ("grid", "sparse", "tin")
+LATTICE_BACKENDS = ("grid", "sparse")  # the back-ends whose size is set by grid.cell_m
+WINDOW = (1280, 720)
+FRAMES = 200
+# The motion: the tool waits 1.5 s above the sand, so that the window is up before the first stamp (the first
+# frame uploads the whole lattice, longest on the largest; a stamp during it waits for it); holds and stroke
+# shorter than haptics_trajectory's defaults, so that 200 frames cover the 3.1 s of motion at the window's 60 Hz
+# pacing.
+MOTION = {"wait_s": 1.5, "hold_s": 0.2, "stroke_s": 1.0}
+# (domain side m, grid cell m) per profile; the TIN runs once per side.
+DOMAINS = {"tiny": [(1.0, 0.01)],
+           "paper": [(1.0, 0.01), (1.0, 0.005), (1.0, 0.002), (1.0, 0.001), (2.0475, 0.0005)]}
+TINY_BACKENDS = ("grid",)
+# The bars' cases: the 1 m replay at 5 and 1 mm, and the 4096 x 4096 grid.
+COARSE, FINE, LARGE = (1.0, 0.005), (1.0, 0.001), (2.0475, 0.0005)
+NEAR = 0.1  # a figure within 10 % of its bar is flagged: one run each, on a shared machine
+COST_REPEATS = 3
+
+# (values key, table header, stats key)
+COLUMNS = [("fps", "fps", "fps"), ("frame_p50", "frame ms p50", "frame_ms.p50"),
+           ("frame_p99", "frame ms p99", "frame_ms.p99"),
+           ("latency_p50", "stamp to frame ms p50", "stamp_to_frame_ms.p50"),
+           ("latency_p95", "stamp to frame ms p95", "stamp_to_frame_ms.p95"),
+           ("step_p50", "sim step ms p50", "sim.step_ms.p50"), ("step_p95", "sim step ms p95", "sim.step_ms.p95"),
+           ("display_p95", "display ms p95", "display_ms.p95"), ("upload_p95", "upload ms p95", "upload_ms.p95"),
+           ("stamps", "stamps", "sim.stamps"), ("steps", "sim steps", "sim.steps")]
+
+
+def cases(profile_name):
+    """(back-end, domain side m, cell m or None for the TIN) in table order."""
+    domains = DOMAINS.get(profile_name, DOMAINS["paper"])
+    backends = TINY_BACKENDS if profile_name == "tiny" else BACKENDS
+    out = []
+    for b in backends:
+        if b in LATTICE_BACKENDS:
+            out += [(b, side, cell) for side, cell in domains]
+        else:
+            out += [(b, side, None) for side in dict.fromkeys(side for side, _ in domains)]
+    return out
+
+
+def case_name(case):
+    b, side, cell = case
+    return f"{b}-{side:g}m" + (f"-{cell * 1e3:g}mm" if cell is not None else "")
+
+
+def overrides(case):
+    _, side, cell = case
+    sets = [f"domain.size_m=[{side!r}, {side!r}]"]
+    return sets + ([f"grid.cell_m={cell!r}"] if cell is not None else [])
+
+
+def trajectory_file(folder, side):
+    """The replay for a domain of SIDE metres: the motion centred on it (written once, the same bytes each time)."""
+    path = folder / f"stroke-{side:g}m.csv"
+    rows = haptics_trajectory.trajectory(centre=(0.5 * side, 0.5 * side), **MOTION)
+    tmp = path.with_suffix(".tmp")
+    haptics_trajectory.write(tmp, rows)
+    if path.exists() and path.read_bytes() == tmp.read_bytes():
+        tmp.unlink()
+    else:
+        tmp.replace(path)
+    return path
+
+
+def figures(case, stats):
+    """A case's row values from its stats JSON. Without a stamp there is no latency (the stats' percentile of
+    nothing is 0): NaN."""
+    row = {key: float(stats[name]) for key, _, name in COLUMNS}
+    row["elements"] = int(stats["vertices"] if case[0] == "tin" else stats["cells"])
+    if row["stamps"] == 0:
+        row["latency_p50"] = row["latency_p95"] = float("nan")
+    return row
+
+
+def renderer_of(all_stats):
+    names = sorted({str(s.get("gl_renderer", "unknown")) for s in all_stats}) or ["unknown"]
+    return ", ".join(names)
+
+
+def bar(label, backend, value, limit, at_least, unit=""):
+    """One bar's line: met or missed, and flagged when the figure is within NEAR of the bar."""
+    met = value >= limit if at_least else value <= limit
+    near = limit > 0 and abs(value / limit - 1.0) < NEAR
+    return {"bar": label, "backend": backend, "measured": f"{value:.3g}{unit}",
+            "limit": f"{'>=' if at_least else '<='} {limit:g}{unit}",
+            "verdict": ("met" if met else "missed") + (f" (within {NEAR:.0%})" if near else ""), "met": met}
+
+
+def judge(rows):
+    """The bars against the rows ({case: figures}) that the profile ran."""
+    out = []
+    for b in LATTICE_BACKENDS:
+        coarse, fine = rows.get((b, *COARSE)), rows.get((b, *FINE))
+        if coarse and fine:
+            out.append(bar("fps 1 mm / 5 mm", b, fine["fps"] / coarse["fps"], 0.8, True))
+            out.append(bar("sim step p95 1 mm / 5 mm", b, fine["step_p95"] / coarse["step_p95"], 1.5, False))
+            out.append(bar("stamp to frame p95 at 1 mm", b, fine["latency_p95"], 50, False, " ms"))
+    large = rows.get(("grid", *LARGE))
+    if large:
+        out.append(bar("fps at 4096 x 4096", "grid", large["fps"], 15, True))
+        # The stats give the p95, not the largest: "each stamp" is read at the p95.
+        out.append(bar("stamp to frame p95 at 4096 x 4096", "grid", large["latency_p95"], 100, False, " ms"))
+    return out
+
+
+def bars_table(bars):
+    md = "| bar | back-end | measured | bar | verdict |\n|---|---|---|---|---|\n"
+    return md + "".join(f"| {b['bar']} | {b['backend']} | {b['measured']} | {b['limit']} | {b['verdict']} |\n"
+                        for b in bars)
+
+
+def plot(ctx, rows, renderer):
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import FuncFormatter
+    plain = FuncFormatter(lambda y, _: f"{y:g}")
+    some = FuncFormatter(lambda y, _: f"{y:g}" if f"{y:.0e}"[0] in "25" else "")  # minor ticks: 2 and 5 only
+    panels = [("fps", "frames per second", [(15, "4096^2 bar")]),
+              ("latency_p95", "stamp to frame p95, ms", [(50, "1 m bar"), (100, "4096^2 bar")]),
+              ("step_p95", "sim step p95, ms", [])]
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
+    for ax, (key, label, lines) in zip(axes, panels):
+        for b in BACKENDS:
+            pts = sorted((r["elements"], r[key]) for c, r in rows.items() if c[0] == b and r[key] > 0)
+            if pts:
+                ax.plot(*zip(*pts), "o-", label=b)
+        for y, text in lines:
+            ax.axhline(y, color="0.6", ls="--", lw=0.8)
+            ax.annotate(text, (0.02, y), xycoords=("axes fraction", "data"), fontsize=7, color="0.4", va="bottom")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.yaxis.set_major_formatter(plain)
+        ax.yaxis.set_minor_formatter(some)
+        ax.tick_params(axis="y", which="minor", labelsize=7)
+        ax.set_xlabel("elements (grid nodes, TIN vertices)")
+        ax.set_ylabel(label)
+    axes[0].legend(fontsize=8)
+    fig.suptitle(f"{WINDOW[0]} x {WINDOW[1]} window under Xvfb, renderer: {renderer}", fontsize=9)
+    fig.tight_layout()
+    return ctx.figure(fig, "interactive_scaling")
+
+
+def run_cases(ctx, todo):
+    """{case: stats dict}: each case replayed once, reused when this binary already ran it with these inputs
+    (the stats file is written whole or not at all)."""
+    import json
+    folder = ctx.runs / "interactive_scaling" / "replays"
+    folder.mkdir(parents=True, exist_ok=True)
+    # Every profile's replays, so that the folder's identity does not depend on the profile.
+    sides = dict.fromkeys(side for domains in DOMAINS.values() for side, _ in domains)
+    trajectories = {side: trajectory_file(folder, side) for side in sides}
+    what = ["interactive scaling", SCENE, FRAMES, WINDOW, *trajectories.values()]
+    if not ctx.is_current(folder, what):
+        for old in folder.glob("*.json"):
+            old.unlink()
+        ctx.mark_current(folder, what)
+    out = {}
+    for case in todo:
+        stats = folder / f"{case_name(case)}.json"
+        if not stats.exists():
+            sbrun.progress(f"  interactive_scaling: replaying on {case_name(case)}")
+            exp_haptics.run_interactive(ctx.sandbench, SCENE, case[0], trajectories[case[1]], stats,
+                                        overrides(case), FRAMES, WINDOW)
+        out[case] = json.loads(stats.read_text())
+        if out[case]["sim.stamps"] == 0:
+            sbrun.progress(f"  interactive_scaling: no stamp on {case_name(case)} (the run ended before the plunge)")
+    return out
+
+
+def stamp_costs(ctx, todo):
+    """{back-end: {touched, step}}: what the stroke's stamps touch and what a stamp's step (the stamp and its
+    erosion) costs at 1 mm over 5 mm, from `sandbench run` on the same stroke (no window, no servo), for the lattice
+    back-ends the profile runs at both. The step is the median of COST_REPEATS runs' step p50 (the phases' totals
+    are not used: at 5 mm the whole stroke takes a few ms, and a one-time cost of some ms lands in either phase)."""
+    import statistics
+    pairs = [b for b in LATTICE_BACKENDS if (b, *COARSE) in todo and (b, *FINE) in todo]
+    c, half = 0.5 * COARSE[0], 0.05 / 2 ** 0.5  # the replay's stroke: 0.1 m along the diagonal, centred
+    path = f"stroke.path_m=[[{c - half:.6f}, {c - half:.6f}], [{c + half:.6f}, {c + half:.6f}]]"
+    keys = [(b, side, cell, i) for b in pairs for side, cell in (COARSE, FINE) for i in range(COST_REPEATS)]
+    jobs = [(SCENE, b, f"interactive_scaling/{case_name((b, side, cell))}-{i}", overrides((b, side, cell)) + [path])
+            for b, side, cell, i in keys]
+    runs = dict(zip(keys, ctx.run_many("interactive_scaling", jobs)))
+
+    def median(b, size, key):
+        return statistics.median(runs[(b, *size, i)][key] for i in range(COST_REPEATS))
+    return {b: {k: median(b, FINE, name) / median(b, COARSE, name) for k, name in
+                [("touched", "elements_touched"), ("step", "step_ms.p50")]}
+            for b in pairs}
+
+
+def run(ctx):
+    if shutil.which("xvfb-run") is None:
+        return {"skipped": "xvfb-run is not installed (`make deps`)"}
+    todo = cases(ctx.profile_name)
+    costs = stamp_costs(ctx, todo)  # first: the driver runs them on its engine before the replays
+    stats = run_cases(ctx, todo)
+    return values(ctx, {c: figures(c, s) for c, s in stats.items()}, renderer_of(stats.values()), costs)
+
+
+def order(case):
+    """Table order: back-end, then domain, coarse cells first."""
+    b, side, cell = case
+    return BACKENDS.index(b), side, -(cell or 0.0)
+
+
+def values(ctx, rows, renderer, costs=None):
+    """The section's values from the rows ({case: figures}) and the stamps' costs (stamp_costs): figure, table,
+    bars, summary cells."""
+    todo = sorted(rows, key=order)
+    png = plot(ctx, rows, renderer)
+    table_rows = [[b, side, cell * 1e3 if cell is not None else "", rows[(b, side, cell)]["elements"]] +
+                  [rows[(b, side, cell)][key] for key, _, _ in COLUMNS] for b, side, cell in todo]
+    md = ctx.table("interactive_scaling", ["back-end", "domain m", "cell mm", "elements"] +
+                   [header for _, header, _ in COLUMNS], table_rows)
+    bars = judge(rows)
+    summary = {}
+    for b in BACKENDS:  # the finest 1 m case of each back-end
+        one_m = [c for c in todo if c[0] == b and c[1] == 1.0]
+        if one_m:
+            r = rows[one_m[-1]]
+            summary[b] = {"interactive frame rate": f"{r['fps']:.0f} fps at {r['elements']:.2g} "
+                          f"{'vertices' if b == 'tin' else 'nodes'}, {WINDOW[0]}x{WINDOW[1]}"}
+    # How many median frames a stamp waits to be shown (p95), over the runs that stamped.
+    lags = [r["latency_p95"] / r["frame_p50"] for r in rows.values() if r["stamps"] > 0 and r["frame_p50"] > 0]
+    tin = [rows[c] for c in todo if c[0] == "tin" and c[1] == 1.0]
+    return {"skipped": "", "png": png, "table": md, "renderer": renderer, "window": f"{WINDOW[0]} x {WINDOW[1]}",
+            "lag_lo": min(lags, default=float("nan")), "lag_hi": max(lags, default=float("nan")),
+            "tin_fps": tin[0]["fps"] if tin else float("nan"),
+            "frames": FRAMES, "bars": bars, "bars_table": bars_table(bars) if bars else "",
+            "met": sum(b["met"] for b in bars), "rows": {case_name(c): r for c, r in rows.items()},
+            "costs": costs or {}, "summary": summary}
+
+
+if __name__ == "__main__":
+    sbrun.main(run)
