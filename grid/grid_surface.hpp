@@ -3,7 +3,9 @@
 // provide layout(), z(ix, iy) and carry_m3()): the mesh, sampling, the steepest slope and
 // the height checks, written once so that the dense and sparse grids answer alike.
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <string>
 #include <vector>
@@ -15,7 +17,43 @@
 
 namespace sb::grid {
 
-// Two triangles per cell, counter-clockwise seen from above; vertex k = node k. O(nodes).
+// The two triangles of cell (ix, iy), counter-clockwise seen from above; vertex k = node k.
+inline std::array<std::array<std::uint32_t, 3>, 2> grid_cell_triangles(const GridLayout& layout, std::size_t ix,
+                                                                       std::size_t iy) {
+  const std::uint32_t a = layout.index(ix, iy), b = a + 1;
+  const std::uint32_t c = layout.index(ix, iy + 1), d = c + 1;
+  return {{{a, b, d}, {a, d, c}}};
+}
+
+// The same mesh as grid_mesh, handed to `sink` a row of nodes (then a row of cells) at a
+// time, so that writing it holds no copy of the whole mesh: the run file's writer for
+// either storage. O(nodes) time, O(nx) memory.
+template <class H>
+void grid_stream_mesh(const H& h, MeshSink& sink) {
+  const GridLayout& layout = h.layout();
+  sink.begin(layout.nodes(), 2 * (layout.nx - 1) * (layout.ny - 1), 0);
+  std::vector<Vec3> row(layout.nx);
+  for (std::size_t iy = 0; iy < layout.ny; ++iy) {
+    for (std::size_t ix = 0; ix < layout.nx; ++ix) {
+      const Vec2 p = layout.position(ix, iy);
+      row[ix] = Vec3(p.x(), p.y(), h.z(ix, iy));
+    }
+    sink.vertices(row);
+  }
+  row = {};
+  std::vector<std::array<std::uint32_t, 3>> cells(2 * (layout.nx - 1));
+  for (std::size_t iy = 0; iy + 1 < layout.ny; ++iy) {
+    for (std::size_t ix = 0; ix + 1 < layout.nx; ++ix) {
+      const auto pair = grid_cell_triangles(layout, ix, iy);
+      cells[2 * ix] = pair[0];
+      cells[2 * ix + 1] = pair[1];
+    }
+    sink.triangles(cells);
+  }
+  sink.constrained_edges({});
+}
+
+// Two triangles per cell (grid_cell_triangles); vertex k = node k. O(nodes).
 template <class H>
 SurfaceMesh grid_mesh(const H& h) {
   const GridLayout& layout = h.layout();
@@ -29,10 +67,9 @@ SurfaceMesh grid_mesh(const H& h) {
   m.triangles.reserve(2 * (layout.nx - 1) * (layout.ny - 1));
   for (std::size_t iy = 0; iy + 1 < layout.ny; ++iy)
     for (std::size_t ix = 0; ix + 1 < layout.nx; ++ix) {
-      const std::uint32_t a = layout.index(ix, iy), b = a + 1;
-      const std::uint32_t c = layout.index(ix, iy + 1), d = c + 1;
-      m.triangles.push_back({a, b, d});
-      m.triangles.push_back({a, d, c});
+      const auto pair = grid_cell_triangles(layout, ix, iy);
+      m.triangles.push_back(pair[0]);
+      m.triangles.push_back(pair[1]);
     }
   return m;
 }

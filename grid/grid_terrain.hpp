@@ -69,7 +69,7 @@
 namespace sb::grid {
 
 // The operations both grids share are GridTerrainBase's (grid_terrain_base.hpp); this class
-// adds the dense storage's name, check() and row-by-row stream_mesh().
+// adds the dense storage's name and check().
 template <class Real>
 class GridTerrain final : public GridTerrainBase<HeightGrid<Real>, ActiveSet> {
  public:
@@ -79,7 +79,6 @@ class GridTerrain final : public GridTerrainBase<HeightGrid<Real>, ActiveSet> {
       : GridTerrainBase<HeightGrid<Real>, ActiveSet>(layout, initial, neighbours, idle_passes) {}
 
   std::string_view name() const override { return "grid"; }
-  void stream_mesh(MeshSink& sink) const override;  // O(n) time, O(nx) memory
   IntegrityReport check() const override;
 };
 

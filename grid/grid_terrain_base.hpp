@@ -6,9 +6,9 @@
 // the active set and the erosion tables, and implements every Terrain operation whose code
 // does not depend on the storage: stamp (the stamp kernel, then the changed nodes and their
 // neighbours join the active set), erode (the erosion kernel with the settling cascade),
-// simplify (nothing to do), volume, stats, mesh, sample, max_slope_deg. The final classes
-// add their name, check() and what their storage needs besides (the sparse grid prunes
-// uniform blocks after settling, the dense one streams its mesh row by row).
+// simplify (nothing to do), volume, stats, mesh (and its row-by-row stream), sample, max_slope_deg.
+// The final classes add their name, check() and what their storage needs besides (the sparse
+// grid prunes uniform blocks after settling).
 //
 // Costs: those stated in grid_terrain.hpp (dense) and sparse_terrain.hpp (sparse).
 // The member functions are defined here but instantiated only in grid_terrain.cpp and
@@ -43,6 +43,7 @@ class GridTerrainBase : public Terrain {
   double volume() const override { return heights_.volume(); }
   ModelStats stats() const override;
   SurfaceMesh mesh() const override { return grid_mesh(heights_); }
+  void stream_mesh(MeshSink& sink) const override { grid_stream_mesh(heights_, sink); }  // O(nx) memory
   void sample(Raster& out) const override { grid_sample(heights_, out); }
   double max_slope_deg() const override { return grid_max_slope_deg(heights_, stencil_); }
   std::optional<HeightLattice> lattice() const override;

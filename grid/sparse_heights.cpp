@@ -50,31 +50,42 @@ SparseHeights<Real>::SparseHeights(const GridLayout& layout, const std::function
       blocks_x_((layout.nx + kBlock - 1) / kBlock),
       blocks_y_((layout.ny + kBlock - 1) / kBlock) {
   const std::size_t block_count = blocks_x_ * blocks_y_;
-  // Every block's heights, in voxel order; a block overhanging the grid repeats its first
+  // Block (bx, by)'s heights, in voxel order; a block overhanging the grid repeats its first
   // node in the voxels outside it. Plain rounding: the initial volume is what is stored.
-  std::vector<std::array<Real, kBlock * kBlock>> values(block_count);
-  std::vector<std::uint8_t> uniform(block_count, 1);
+  // Returns whether every node has the first one's height. Evaluated block by block, twice
+  // for a block that is not uniform, so that building holds one block's heights at a time
+  // rather than the whole grid's (which a sparse grid exists to avoid).
+  std::array<Real, kBlock * kBlock> v;
+  const auto fill_block = [&](std::size_t bx, std::size_t by) {
+    const Real first = static_cast<Real>(initial(layout_.position(bx * kBlock, by * kBlock)));
+    v.fill(first);
+    bool uniform = true;
+    for (std::size_t iy = by * kBlock; iy < std::min(layout_.ny, (by + 1) * kBlock); ++iy)
+      for (std::size_t ix = bx * kBlock; ix < std::min(layout_.nx, (bx + 1) * kBlock); ++ix) {
+        const Real z = static_cast<Real>(initial(layout_.position(ix, iy)));
+        v[voxel_offset(ix, iy)] = z;
+        if (!same_bits(z, first)) uniform = false;
+      }
+    return uniform;
+  };
+  // First pass: each block's first height and whether it is uniform at it.
+  std::vector<Real> first_height(block_count);
+  std::vector<std::uint8_t> uniform(block_count);
   for (std::size_t by = 0; by < blocks_y_; ++by)
     for (std::size_t bx = 0; bx < blocks_x_; ++bx) {
-      auto& v = values[by * blocks_x_ + bx];
-      const Real first = static_cast<Real>(initial(layout_.position(bx * kBlock, by * kBlock)));
-      v.fill(first);
-      for (std::size_t iy = by * kBlock; iy < std::min(layout_.ny, (by + 1) * kBlock); ++iy)
-        for (std::size_t ix = bx * kBlock; ix < std::min(layout_.nx, (bx + 1) * kBlock); ++ix) {
-          const Real z = static_cast<Real>(initial(layout_.position(ix, iy)));
-          v[voxel_offset(ix, iy)] = z;
-          if (!same_bits(z, first)) uniform[by * blocks_x_ + bx] = 0;
-        }
+      const std::size_t b = by * blocks_x_ + bx;
+      uniform[b] = fill_block(bx, by);
+      first_height[b] = v[0];
     }
   // The background: the height most uniform blocks share (ties: the first such block);
   // with no uniform block it does not matter.
   std::map<Real, std::size_t> uniform_heights;
-  background_ = values[0][0];
+  background_ = first_height[0];
   std::size_t most = 0;
   for (std::size_t b = 0; b < block_count; ++b) {
     if (!uniform[b]) continue;
-    const std::size_t n = ++uniform_heights[values[b][0]];
-    if (n > most) most = n, background_ = values[b][0];
+    const std::size_t n = ++uniform_heights[first_height[b]];
+    if (n > most) most = n, background_ = first_height[b];
   }
 
   tree_ = std::make_unique<Tree>(background_);
@@ -82,10 +93,11 @@ SparseHeights<Real>::SparseHeights(const GridLayout& layout, const std::function
     for (std::size_t bx = 0; bx < blocks_x_; ++bx) {
       const std::size_t b = by * blocks_x_ + bx;
       if (uniform[b]) {
-        if (!same_bits(values[b][0], background_))
-          tree_->tree.addTile(1, Tree::origin(bx, by), values[b][0], /*active=*/false);
+        if (!same_bits(first_height[b], background_))
+          tree_->tree.addTile(1, Tree::origin(bx, by), first_height[b], /*active=*/false);
       } else {
-        std::copy(values[b].begin(), values[b].end(), tree_->tree.touchLeaf(Tree::origin(bx, by))->buffer().data());
+        fill_block(bx, by);
+        std::copy(v.begin(), v.end(), tree_->tree.touchLeaf(Tree::origin(bx, by))->buffer().data());
       }
     }
   openvdb::tools::prune(tree_->tree, Real(0), /*threaded=*/false);

@@ -7,6 +7,7 @@
 namespace {
 
 std::atomic<long long> g_live_bytes{0};
+std::atomic<long long> g_peak_bytes{0};
 // A header in front of each block remembers its size; 16 bytes keep the alignment of new.
 constexpr std::size_t kHeader = 16;
 
@@ -14,7 +15,11 @@ void* counted_alloc(std::size_t n) {
   void* raw = std::malloc(n + kHeader);
   if (!raw) throw std::bad_alloc();
   *static_cast<std::size_t*>(raw) = n;
-  g_live_bytes.fetch_add(static_cast<long long>(n), std::memory_order_relaxed);
+  const long long live =
+      g_live_bytes.fetch_add(static_cast<long long>(n), std::memory_order_relaxed) + static_cast<long long>(n);
+  long long peak = g_peak_bytes.load(std::memory_order_relaxed);
+  while (live > peak && !g_peak_bytes.compare_exchange_weak(peak, live, std::memory_order_relaxed)) {
+  }
   return static_cast<char*>(raw) + kHeader;
 }
 
@@ -29,6 +34,8 @@ void counted_free(void* p) noexcept {
 
 namespace sb::test {
 long long live_heap_bytes() { return g_live_bytes.load(); }
+long long peak_heap_bytes() { return g_peak_bytes.load(); }
+void reset_peak_heap_bytes() { g_peak_bytes.store(g_live_bytes.load()); }
 }  // namespace sb::test
 
 void* operator new(std::size_t n) { return counted_alloc(n); }

@@ -196,6 +196,25 @@ TYPED_TEST(SparseHeightsTest, BytesMatchTheAllocatorAndOpenVdbsMemUsage) {
   EXPECT_EQ(held(), 0u);
 }
 
+// Building holds one block's heights at a time, not the grid's: a 4096 x 4096 bed (16.8 M
+// nodes, 134 MB as doubles) peaks at the model's own bytes and the first pass's two entries
+// per block.
+TYPED_TEST(SparseHeightsTest, BuildingALargeBedHoldsNoCopyOfTheGrid) {
+  const GridLayout g = GridLayout::covering({{0.0, 0.0}, {4.095, 4.095}}, 0.001);
+  ASSERT_EQ(g.nodes(), 4096u * 4096u);
+  const auto bed = [](const Vec2& p) { return p.x() < 0.5 && p.y() < 0.5 ? 0.1 + 0.01 * p.x() : 0.1; };
+  const long long before = ::sb::test::live_heap_bytes();
+  ::sb::test::reset_peak_heap_bytes();
+  const SparseHeights<TypeParam> h(g, bed);
+  const long long peak = ::sb::test::peak_heap_bytes() - before;
+  const double blocks = static_cast<double>(g.nodes()) / 64.0;
+  const double first_pass = blocks * static_cast<double>(sizeof(TypeParam) + 1);
+  EXPECT_LE(static_cast<double>(peak), static_cast<double>(sizeof(h) + h.bytes()) + first_pass + (1 << 20))
+      << "model " << h.bytes() << " bytes";
+  EXPECT_LT(static_cast<double>(peak), 0.1 * static_cast<double>(g.nodes() * sizeof(TypeParam)));
+  EXPECT_GT(h.counts().leaves, 0u);  // the sloped corner is stored
+}
+
 TEST(SparseHeightsMapping, EveryNodeOfABlockHasItsOwnVoxel) {
   std::vector<int> seen(64, 0);
   for (std::size_t y = 0; y < 8; ++y)
