@@ -48,6 +48,7 @@ COLUMNS = [("fps", "fps", "fps"), ("frame_p50", "frame ms p50", "frame_ms.p50"),
            ("frame_p99", "frame ms p99", "frame_ms.p99"),
            ("latency_p50", "stamp to frame ms p50", "stamp_to_frame_ms.p50"),
            ("latency_p95", "stamp to frame ms p95", "stamp_to_frame_ms.p95"),
+           ("latency_max", "stamp to frame ms max", "stamp_to_frame_ms.max"),
            ("step_p50", "sim step ms p50", "sim.step_ms.p50"), ("step_p95", "sim step ms p95", "sim.step_ms.p95"),
            ("display_p95", "display ms p95", "display_ms.p95"), ("upload_p95", "upload ms p95", "upload_ms.p95"),
            ("stamps", "stamps", "sim.stamps"), ("steps", "sim steps", "sim.steps")]
@@ -93,10 +94,11 @@ def trajectory_file(folder, side):
 def figures(case, stats):
     """A case's row values from its stats JSON. Without a stamp there is no latency (the stats' percentile of
     nothing is 0): NaN."""
-    row = {key: float(stats[name]) for key, _, name in COLUMNS}
+    # (stamp_to_frame_ms.max is absent from binaries older than the key: NaN.)
+    row = {key: float(stats.get(name, float("nan"))) for key, _, name in COLUMNS}
     row["elements"] = int(stats["vertices"] if case[0] == "tin" else stats["cells"])
     if row["stamps"] == 0:
-        row["latency_p50"] = row["latency_p95"] = float("nan")
+        row["latency_p50"] = row["latency_p95"] = row["latency_max"] = float("nan")
     return row
 
 
@@ -126,8 +128,7 @@ def judge(rows):
     large = rows.get(("grid", *LARGE))
     if large:
         out.append(bar("fps at 4096 x 4096", "grid", large["fps"], 15, True))
-        # The stats give the p95, not the largest: "each stamp" is read at the p95.
-        out.append(bar("stamp to frame p95 at 4096 x 4096", "grid", large["latency_p95"], 100, False, " ms"))
+        out.append(bar("stamp to frame, largest, at 4096 x 4096", "grid", large["latency_max"], 100, False, " ms"))
     return out
 
 

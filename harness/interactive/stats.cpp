@@ -86,6 +86,7 @@ Json haptic_stats_json(const haptics::ServoStats& s, const haptics::DeviceLimits
   j["upload_ms.p95"] = percentile(info.upload_ms, 0.95);
   j["stamp_to_frame_ms.p50"] = percentile(info.stamp_to_frame_ms, 0.5);
   j["stamp_to_frame_ms.p95"] = percentile(info.stamp_to_frame_ms, 0.95);
+  j["stamp_to_frame_ms.max"] = percentile(info.stamp_to_frame_ms, 1.0);
   j["backend"] = info.backend;
   j["device"] = info.device;
   j["gl_renderer"] = info.gl_renderer;

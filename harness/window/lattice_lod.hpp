@@ -19,7 +19,7 @@
 
 namespace sb {
 
-inline constexpr std::size_t kLodCells = 128;   // cells per side of a patch when levelled
+inline constexpr std::size_t kLodCells = 64;    // cells per side of a patch when levelled
 inline constexpr std::size_t kFullCells = 256;  // lattices up to this many cells a side are drawn whole
 
 struct LatticePatch {
