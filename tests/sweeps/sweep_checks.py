@@ -9,9 +9,10 @@ from pathlib import Path
 # A table column or summary key that holds a wall-clock measurement (or a quantity fitted to
 # one), which differs from run to run: "tool s", "step ms p50", "time s", "time_s.total"...
 TIMING = re.compile(r"(^|[\s_.])(s|ms)($|[\s_.])|time|per_s|step p50|settling", re.IGNORECASE)
-# Tables measured in real time as a whole (the haptic replay: where the stamps fall depends on
-# how fast the simulation thread ran), compared by shape only: headers, rows, first column.
-REAL_TIME_TABLES = {"haptics.csv"}
+# Tables measured in real time as a whole (the haptic and the interactive replays: where the
+# stamps fall and how many steps run depend on how fast the threads ran), compared by shape
+# only: headers, rows, first column.
+REAL_TIME_TABLES = {"haptics.csv", "interactive_scaling.csv"}
 # Tables with a row per measure, named in the given column (the bars: a step time, an RMSE, a
 # memory...): a row whose measure is timed is compared by its columns up to that one only.
 ROW_TIMED_TABLES = {"bars.csv": 1}
