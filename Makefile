@@ -40,7 +40,7 @@ ASAN_ALL ?= 0
 test-asan:
 	@LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
 		UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-		$(MAKE) --no-print-directory test PRESET=asan-ubsan $(if $(filter 1,$(ASAN_ALL)),,TEST_EXCLUDE=^slurm_sweep$$$$)
+		$(MAKE) --no-print-directory test PRESET=asan-ubsan $(if $(filter 1,$(ASAN_ALL)),,TEST_EXCLUDE=^slurm_sweep)
 
 # The haptics tests (servo loop, lock-free buffers, UDP device: the tests named Haptics*) under
 # ThreadSanitizer; only their test executable is built. A race report fails the run.
