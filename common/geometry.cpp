@@ -38,20 +38,27 @@ bool point_in_polygon(std::span<const Vec2> polygon, const Vec2& p) {
   return inside;
 }
 
-double distance_to_segment(const Vec2& p, const Vec2& a, const Vec2& b) {
+namespace {
+double squared_distance_to_segment(const Vec2& p, const Vec2& a, const Vec2& b) {
   const Vec2 ab = b - a;
   const double len2 = ab.squaredNorm();
   const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
+  return (a + t * ab - p).squaredNorm();
+}
+}  // namespace
+
+double distance_to_segment(const Vec2& p, const Vec2& a, const Vec2& b) {
+  return std::sqrt(squared_distance_to_segment(p, a, b));
 }
 
 double distance_to_boundary(std::span<const Vec2> polygon, const Vec2& p) {
+  // One square root for the nearest side: the root is monotone and correctly rounded, so this
+  // equals the least of the sides' distances exactly.
   double best = std::numeric_limits<double>::infinity();
   const std::size_t n = polygon.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    best = std::min(best, distance_to_segment(p, polygon[i], polygon[(i + 1) % n]));
-  }
-  return best;
+  for (std::size_t i = 0, j = n - 1; i < n; j = i++)
+    best = std::min(best, squared_distance_to_segment(p, polygon[j], polygon[i]));
+  return std::sqrt(best);
 }
 
 namespace {

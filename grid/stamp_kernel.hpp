@@ -61,58 +61,6 @@ inline std::vector<Deposit> widened_rim(const GridLayout& layout, const ToolStam
   return rim;
 }
 
-// The nodes of a bulldozing stamp's front pile (common/front_pile.hpp), each weighted by its
-// depth under the pile. The region sampled starts at the pile's reach on flat ground and widens
-// until it holds every node the pile covers (the pile carried from earlier stamps raises the
-// level: a round or two more) or the corridor runs off the grid. Empty when no node lies ahead
-// of the tool.
-template <class Store>
-std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, double volume) {
-  const GridLayout& layout = grid.layout();
-  const double tan = s.rim.tan_repose;
-  const Aabb2 footprint_box = bounds(s.footprint);
-  double reach = std::max({front_pile_flat_reach(volume, 2.0 * s.half_width_m, tan), s.rim.width_m, layout.diagonal()});
-  std::vector<std::uint32_t> nodes;
-  std::vector<PileSample> samples;
-  std::size_t sampled_before = 0;
-  // Each round at least 1.5 times wider: 64 outgrow any domain; the bound guards non-finite input.
-  for (int round = 0; round < 64; ++round) {
-    nodes.clear();
-    samples.clear();
-    const Aabb2 window = footprint_box.expanded(reach);
-    const NodeRange r = layout.nodes_in(window);
-    double lowest = HUGE_VAL;
-    for (std::size_t iy = r.y0; !r.empty && iy <= r.y1; ++iy) {
-      for (std::size_t ix = r.x0; ix <= r.x1; ++ix) {
-        const Vec2 p = layout.position(ix, iy);
-        if (!in_front_pile(s, p) || s.contains(p)) continue;
-        const double d = distance_to_boundary(s.footprint, p);
-        if (d > reach) continue;
-        const std::uint32_t k = layout.index(ix, iy);
-        nodes.push_back(k);
-        samples.push_back({d, grid.z(k), layout.area(k)});
-        lowest = std::min(lowest, samples.back().z_m);
-      }
-    }
-    if (samples.empty()) return {};
-    const double level = front_pile_level(samples, volume, tan);
-    const double needed = front_pile_reach_needed(level, lowest, tan);
-    // No node gained since the last round: the corridor runs off the grid, and a wider window
-    // would only rescan it (up to the whole grid, every stamp, with a pile against the border).
-    const bool off_grid = nodes.size() == sampled_before;
-    sampled_before = nodes.size();
-    if (needed <= reach || off_grid || !std::isfinite(needed)) {
-      std::vector<Deposit> pile;
-      for (std::size_t i = 0; i < nodes.size(); ++i)
-        if (const double depth = front_pile_depth(samples[i], level, tan); depth > 0.0)
-          pile.push_back({nodes[i], depth});
-      return pile;
-    }
-    reach = std::max(1.1 * needed, 1.5 * reach);
-  }
-  return {};
-}
-
 // Two circles about the footprint's vertex centroid that classify most nodes of the window
 // without a polygon test: a node inside the inner circle is in the footprint; a node
 // beyond the outer one is outside it, and beyond the outer one plus the rim width it is
@@ -141,6 +89,72 @@ struct FootprintCircles {
   }
 };
 
+// The nodes of a bulldozing stamp's front pile (common/front_pile.hpp), each weighted by its
+// depth under the pile. The region sampled starts at the pile's reach on flat ground and widens
+// until it holds every node the pile covers (the pile carried from earlier stamps raises the
+// level: a round or two more) or the corridor runs off the grid. Empty when no node lies ahead
+// of the tool. Only the corridor's bounding box is scanned, and the circles classify most of its
+// nodes, so the polygon's distance is taken only for nodes that may lie within the reach.
+template <class Store>
+std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, const FootprintCircles& circles,
+                                      double volume) {
+  const GridLayout& layout = grid.layout();
+  const double tan = s.rim.tan_repose;
+  const Vec2 dir = s.motion_dir, across(-dir.y(), dir.x());
+  // A node of the pile lies ahead of the pose by at most the footprint's front plus the reach.
+  double front = 0.0;
+  for (const Vec2& v : s.footprint) front = std::max(front, (v - s.pose.xy).dot(dir));
+  const double margin = 0.5 * std::min(layout.dx, layout.dy);  // rounding at the corridor's edges
+  const auto corridor = [&](double reach) {
+    const Vec2 side = s.half_width_m * across, ahead = (front + reach) * dir;
+    const Vec2 a = s.pose.xy + side, b = s.pose.xy - side, c = a + ahead, d = b + ahead;
+    return Aabb2{a.cwiseMin(b).cwiseMin(c).cwiseMin(d), a.cwiseMax(b).cwiseMax(c).cwiseMax(d)}.expanded(margin);
+  };
+  const double outer = std::sqrt(circles.outer2);
+  double reach = std::max({front_pile_flat_reach(volume, 2.0 * s.half_width_m, tan), s.rim.width_m, layout.diagonal()});
+  std::vector<std::uint32_t> nodes;
+  std::vector<PileSample> samples;
+  std::size_t sampled_before = 0;
+  // Each round at least 1.5 times wider: 64 outgrow any domain; the bound guards non-finite input.
+  for (int round = 0; round < 64; ++round) {
+    nodes.clear();
+    samples.clear();
+    const NodeRange r = layout.nodes_in(corridor(reach));
+    double lowest = HUGE_VAL;
+    for (std::size_t iy = r.y0; !r.empty && iy <= r.y1; ++iy) {
+      for (std::size_t ix = r.x0; ix <= r.x1; ++ix) {
+        const Vec2 p = layout.position(ix, iy);
+        if (!in_front_pile(s, p)) continue;
+        const double d2 = (p - circles.centre).squaredNorm();
+        if (d2 < circles.inner2 || (d2 <= circles.outer2 && s.contains(p))) continue;
+        if (std::sqrt(d2) - outer > reach) continue;  // a lower bound of its distance to the footprint
+        const double d = distance_to_boundary(s.footprint, p);
+        if (d > reach) continue;
+        const std::uint32_t k = layout.index(ix, iy);
+        nodes.push_back(k);
+        samples.push_back({d, grid.z(k), layout.area(k)});
+        lowest = std::min(lowest, samples.back().z_m);
+      }
+    }
+    if (samples.empty()) return {};
+    const double level = front_pile_level(samples, volume, tan);
+    const double needed = front_pile_reach_needed(level, lowest, tan);
+    // No node gained since the last round: the corridor runs off the grid, and a wider window
+    // would only rescan it (up to the whole grid, every stamp, with a pile against the border).
+    const bool off_grid = nodes.size() == sampled_before;
+    sampled_before = nodes.size();
+    if (needed <= reach || off_grid || !std::isfinite(needed)) {
+      std::vector<Deposit> pile;
+      for (std::size_t i = 0; i < nodes.size(); ++i)
+        if (const double depth = front_pile_depth(samples[i], level, tan); depth > 0.0)
+          pile.push_back({nodes[i], depth});
+      return pile;
+    }
+    reach = std::max(1.1 * needed, 1.5 * reach);
+  }
+  return {};
+}
+
 template <class Store>
 StampReport cut_and_push(Store& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed) {
   const GridLayout& layout = grid.layout();
@@ -152,28 +166,33 @@ StampReport cut_and_push(Store& grid, const ToolStamp& s, std::vector<std::uint3
   const FootprintCircles circles(s);
   std::vector<Cut> cuts;
   std::vector<Deposit> rim;
-  for (std::size_t iy = r.y0; iy <= r.y1; ++iy) {
-    for (std::size_t ix = r.x0; ix <= r.x1; ++ix) {
-      const Vec2 p = layout.position(ix, iy);
-      const double d2 = (p - circles.centre).squaredNorm();
-      if (d2 >= circles.band2) continue;
-      const std::uint32_t k = layout.index(ix, iy);
-      if (d2 < circles.inner2 || (d2 <= circles.outer2 && s.contains(p))) {
-        const double bottom = s.bottom_z(p);
-        if (grid.z(k) > bottom) cuts.push_back({k, bottom});
-      } else if (const double w = s.rim_weight(p); w > 0.0) {
-        rim.push_back({k, w});
+  // The footprint's nodes into `cuts` (cut_pass) or the rim band's into `rim`, in storage order.
+  const auto scan = [&](bool cut_pass) {
+    for (std::size_t iy = r.y0; iy <= r.y1; ++iy) {
+      for (std::size_t ix = r.x0; ix <= r.x1; ++ix) {
+        const Vec2 p = layout.position(ix, iy);
+        const double d2 = (p - circles.centre).squaredNorm();
+        if (d2 >= circles.band2) continue;
+        const std::uint32_t k = layout.index(ix, iy);
+        if (d2 < circles.inner2 || (d2 <= circles.outer2 && s.contains(p))) {
+          const double bottom = s.bottom_z(p);
+          if (cut_pass && grid.z(k) > bottom) cuts.push_back({k, bottom});
+        } else if (!cut_pass) {
+          if (const double w = s.rim_weight_outside(p, distance_to_boundary(s.footprint, p)); w > 0.0)
+            rim.push_back({k, w});
+        }
       }
     }
-  }
+  };
+  scan(true);
   if (cuts.empty()) return report;
   CompensatedSum removed;
   for (const Cut& c : cuts) removed.add(layout.area(c.node) * (grid.z(c.node) - c.bottom_z));
   const double volume = removed.value();
-  if (s.bulldozes()) {
-    // Ahead of the tool; the rim when nothing lies ahead (the tool at the domain's far side).
-    if (std::vector<Deposit> pile = front_pile_nodes(grid, s, volume); !pile.empty()) rim = std::move(pile);
-  }
+  // A bulldozing stamp's sand goes ahead of the tool; the rim takes it when nothing lies ahead
+  // (the tool at the domain's far side) and for every other stamp.
+  if (s.bulldozes()) rim = front_pile_nodes(grid, s, circles, volume);
+  if (rim.empty()) scan(false);
   if (rim.empty()) rim = widened_rim(layout, s);
   // No node outside the footprint (a tool larger than the domain): cutting would lose
   // the volume, so the stamp does nothing.

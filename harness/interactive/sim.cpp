@@ -256,7 +256,10 @@ void Simulation::add_volume(double change_m3) {
 void Simulation::publish_display(bool force) {
   const double now = clock_.seconds();
   const double period = feed_->lattice() ? kTilePeriod_s : kDisplayPeriod_s;
-  if (force || (dirty_ && now - last_surface_s_ >= period)) {
+  // A lattice's changed tiles cost what changed, so a stamp is published at once: waiting for
+  // the period would add up to a period to its latency. A mesh is rebuilt whole, at most once a period.
+  const bool stamp_waiting = feed_->lattice() && !stamp_times_s_.empty();
+  if (force || (dirty_ && (stamp_waiting || now - last_surface_s_ >= period))) {
     Stopwatch sw;
     if (feed_->publish(*terrain_, dirty_ || force, stamp_times_s_)) totals_.display_ms.push_back(1e3 * sw.seconds());
     dirty_ = false;
