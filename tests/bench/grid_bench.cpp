@@ -3,8 +3,8 @@
 // 2048 x 2048 grid with every node active (on one thread and on two), against a plain scalar
 // in-place sweep of the same rule in the same run (BM_ReferenceSweep), against a vectorised
 // two-pass (Jacobi) sweep at its monotone fraction (BM_JacobiSweep), time to rest of both
-// orders (BM_Settle*), and stamp cost against tool area; float and double; the pile and
-// stroke also with the gradient rule.
+// orders (BM_Settle*), stamp cost against tool area (BM_Stamp: the rim; BM_BulldozeStroke: a
+// stroke carrying its front pile); float and double; the pile and stroke also with the gradient rule.
 //
 //   build/<dir>/tests/grid_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 //       --benchmark_enable_random_interleaving=true
