@@ -5,8 +5,8 @@ Two stages per case and seed, each a plain LAMMPS input:
 - `bed`: grains dropped from a loose lattice into the domain, settled, cut flat at the scene's
   bed height and settled again; a restart file and a dump of the settled bed.
 - `tool`: from that restart, the tool plunges at the path's first point, follows the path at the
-  case's speed, lifts out, and the sand settles; dumps with the tool in and after it lifted, and
-  the tool's force and position over time.
+  case's speed, lifts out and is removed, and the sand settles; dumps with the tool in and after
+  it left, and the tool's force and position over time.
 A pour case (`tool.shape = "pour"`) is one stage, `pour`: grains fall from above the pour point
 onto a frozen rough layer of grains at the bed's surface.
 
@@ -302,7 +302,14 @@ def tool_input(geo, material, speed, bed_level, restart="bed.restart", tool_in_d
         "thermo_style custom step time atoms ke v_fx v_fy v_fz",
         f"run {int(math.ceil(tool_in / dt))}",
         f"write_dump sand custom {tool_in_dump} id x y z radius",
-        f"run {int(math.ceil((points[-1][0] - tool_in + n['settle_s']) / dt))}",
+        f"run {int(math.ceil((points[-1][0] - tool_in) / dt))}",
+        # The tool leaves: lifted, it still stood in the pile it pushed (it is taller than any
+        # pile), so it is removed before the sand settles, as a lifted blade is.
+        "unfix force_out",
+        "uncompute tool_on_sand",
+        "unfix tool",
+        "thermo_style custom step time atoms ke",
+        f"run {int(math.ceil(n['settle_s'] / dt))}",
         f"write_dump sand custom {final_dump} id x y z radius",
     ]) + "\n"
 

@@ -7,6 +7,8 @@ tool's force reduced and written to a reference file, which is read back and che
 - the tool met the sand: it was pushed back against its motion while it cut, and the final
   surface has a cut below the bed along the path;
 - a second start finds the run done and runs nothing;
+- the tool is removed after it lifts and before the sand settles (a lifted tool left in place
+  holds the back face of the pile it pushed);
 - a scene it cannot model is refused up front (exit 2, naming the key).
 Usage: dem_tiny_test.py (LAMMPS's `lmp` on PATH; the test is skipped, exit 77, without it)."""
 import shutil
@@ -42,7 +44,26 @@ def refuses_what_it_cannot_model(tmp):
           f"an unsupported scene is refused naming terrain.kind ({proc.stderr.strip()})")
 
 
+def tool_leaves_before_the_sand_settles():
+    """The generated stroke lifts the tool, removes it, then settles: the final surface is sand
+    that stands on its own."""
+    import tomllib
+    import lammps_input
+    with open(ROOT / "tests" / "dem" / "tiny_scene.toml", "rb") as f:
+        scene = tomllib.load(f)
+    with open(ROOT / "experiments" / "dem" / "material.toml", "rb") as f:
+        material = tomllib.load(f)
+    geo = lammps_input.Geometry(scene, material)
+    lines = lammps_input.tool_input(geo, material, 0.2, geo.bed_height).splitlines()
+    runs = [i for i, line in enumerate(lines) if line.startswith("run ")]
+    unfix = lines.index("unfix tool") if "unfix tool" in lines else -1
+    final = next(i for i, line in enumerate(lines) if "final.dump" in line)
+    check(len(runs) == 3 and runs[1] < unfix < runs[2] < final,
+          "the tool is lifted, then removed, then the sand settles, then the final surface is dumped")
+
+
 def main():
+    tool_leaves_before_the_sand_settles()
     with tempfile.TemporaryDirectory() as tmp:
         refuses_what_it_cannot_model(tmp)
     if shutil.which("lmp") is None:
