@@ -3,15 +3,68 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "common/tool.hpp"
 
 namespace sb {
 
+namespace {
+// The footprint's extent along the motion, from the pose: [rear, front].
+std::pair<double, double> along_extent(const ToolStamp& s) {
+  double rear = HUGE_VAL, front = -HUGE_VAL;
+  for (const Vec2& v : s.footprint) {
+    const double along = (v - s.pose.xy).dot(s.motion_dir);
+    rear = std::min(rear, along);
+    front = std::max(front, along);
+  }
+  return {rear, front};
+}
+}  // namespace
+
 bool in_front_pile(const ToolStamp& s, const Vec2& p) {
   const Vec2 offset = p - s.pose.xy;
+  const double along = offset.dot(s.motion_dir);
   const double across = std::abs(offset.x() * s.motion_dir.y() - offset.y() * s.motion_dir.x());
-  return offset.dot(s.motion_dir) > 0.0 && across <= s.half_width_m;
+  // Carrying: beside the tool back to its rear, but not in the trench its rear half sweeps.
+  if (s.carries()) return along > 0.0 || (across > s.half_width_m && along > along_extent(s).first);
+  return along > 0.0 && across <= s.half_width_m;
+}
+
+double pile_distance(const ToolStamp& s, const Vec2& p) {
+  if (!s.carries()) return distance_to_boundary(s.footprint, p);
+  double best = HUGE_VAL;
+  const std::size_t n = s.footprint.size();
+  for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
+    const Vec2 edge = s.footprint[i] - s.footprint[j];
+    const Vec2 outward(edge.y(), -edge.x());  // the footprint is counter-clockwise
+    if (outward.dot(s.motion_dir) > 1e-9 * edge.norm())
+      best = std::min(best, squared_distance_to_segment(p, s.footprint[j], s.footprint[i]));
+  }
+  return std::sqrt(best);
+}
+
+Aabb2 front_pile_box(const ToolStamp& s, double reach, double margin) {
+  if (s.carries()) return bounds(s.footprint).expanded(reach + margin);
+  // The corridor: the footprint's width across the motion, from the pose to its front plus the reach.
+  const Vec2 dir = s.motion_dir, across(-dir.y(), dir.x());
+  double front = 0.0;
+  for (const Vec2& v : s.footprint) front = std::max(front, (v - s.pose.xy).dot(dir));
+  const Vec2 side = s.half_width_m * across, ahead = (front + reach) * dir;
+  const Vec2 a = s.pose.xy + side, b = s.pose.xy - side, c = a + ahead, d = b + ahead;
+  return Aabb2{a.cwiseMin(b).cwiseMin(c).cwiseMin(d), a.cwiseMax(b).cwiseMax(c).cwiseMax(d)}.expanded(margin);
+}
+
+double carried_fraction(const ToolStamp& s, const CarriedPileOrigin& previous) {
+  if (!s.carries() || !previous.valid || s.generation != previous.generation + 1) return 0.0;
+  const auto [rear, front] = along_extent(s);
+  const double length = front - rear, moved = (s.pose.xy - previous.xy).norm();
+  if (!(length > 0.0) || !(moved <= length)) return 0.0;
+  return std::pow(1.0 - s.rim.carry_shed_fraction, moved / length);
+}
+
+CarriedPileOrigin carried_origin(const ToolStamp& s) {
+  return {.valid = s.carries(), .generation = s.generation, .xy = s.pose.xy};
 }
 
 double front_pile_flat_reach(double volume_m3, double width_m, double tan_repose) {

@@ -19,10 +19,24 @@
 // its nodes or vertices as samples, asks for the level and deposits in proportion to the depths;
 // the stamp normalises the deposit, so the volume stays exact.
 //
-// (The particles carry the pile's flanks beside the blade with them; a pile filled beside the
-// front half of the tool too, or around the blade's corners, left those flanks behind as berms
-// several times the particles'. Carrying them needs state between stamps, which this
-// model does not keep: results/particles.md shows what the corridor costs.)
+// Carrying (tool.displacement = "carry", the default): the particles carry the pile's flanks
+// beside the blade with them, and a pile filled beside the tool, left where it lies, leaves those
+// flanks behind as berms several times the particles'. So a carrying stamp first picks up the
+// pile the stamp before it heaped: at every element of that pile outside its footprint, the sand
+// standing above the height the element had before the deposit, all but what the tool sheds,
+//
+//   kept = (1 - carry_shed_fraction)^(moved / length),   length: the footprint's along the motion
+//
+// (what is shed stays: in the corridor the footprint cuts it again, beside it it is berm; the
+// default sheds nothing, and the berms are what erosion spills off the flanks between stamps).
+// Then it heaps its cut and what it picked up as one pile, ahead of the pose and beside the tool
+// back to its rear (not in the trench the tool's rear half sweeps), at the angle of repose
+// falling away from the tool's front face (d: the distance to the footprint's edges that face
+// the motion), so the flanks slope down backwards along the tool instead of standing as a wall
+// that erosion pours into the trench. The state between stamps is that pile's elements and their
+// heights before the deposit, which each back-end keeps; picking up measures what it takes, so
+// the volume stays exact.
+#include <cstdint>
 #include <vector>
 
 #include "common/geometry.hpp"
@@ -38,9 +52,33 @@ struct PileSample {
 };
 
 // Whether p takes part in a bulldozing stamp's front pile: outside the footprint (the caller
-// knows), ahead of the pose along the motion and within the footprint's half width across it.
-// O(1).
+// knows), ahead of the pose along the motion and within the footprint's half width across it;
+// for a carrying stamp, anywhere ahead of the pose and, beside the footprint's width, back to its
+// rear. O(1) (carrying: O(footprint)).
 bool in_front_pile(const ToolStamp& s, const Vec2& p);
+
+// The distance d of the pile's surface from the tool: to the footprint (bulldozing), or to its
+// edges that face the motion (carrying). O(footprint).
+double pile_distance(const ToolStamp& s, const Vec2& p);
+
+// The box holding every point of the pile region (in_front_pile) within `reach` of the
+// footprint, grown by `margin`. O(footprint).
+Aabb2 front_pile_box(const ToolStamp& s, double reach, double margin);
+
+// Which stamp heaped a carried pile, for the next stamp to decide whether it carries it on.
+struct CarriedPileOrigin {
+  bool valid = false;
+  std::uint32_t generation = 0;
+  Vec2 xy{0.0, 0.0};
+};
+
+// What a carrying stamp keeps of the pile `previous` heaped: (1 - shed)^(moved / length) when it
+// follows that stamp (the next generation) and moved at most its own length since, else 0 (a new
+// stroke, or a tool that jumped, starts a new pile). O(footprint).
+double carried_fraction(const ToolStamp& s, const CarriedPileOrigin& previous);
+
+// The origin a carrying stamp leaves for the next one. O(1).
+CarriedPileOrigin carried_origin(const ToolStamp& s);
 
 // The distance from the footprint within which the pile holding `volume_m3` on flat ground
 // ends, ahead of a blade `width_m` wide: the ramp's R with tan * width * R^2 / 2 = V; 0 when

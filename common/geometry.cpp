@@ -38,14 +38,12 @@ bool point_in_polygon(std::span<const Vec2> polygon, const Vec2& p) {
   return inside;
 }
 
-namespace {
 double squared_distance_to_segment(const Vec2& p, const Vec2& a, const Vec2& b) {
   const Vec2 ab = b - a;
   const double len2 = ab.squaredNorm();
   const double t = len2 > 0.0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
   return (a + t * ab - p).squaredNorm();
 }
-}  // namespace
 
 double distance_to_segment(const Vec2& p, const Vec2& a, const Vec2& b) {
   return std::sqrt(squared_distance_to_segment(p, a, b));

@@ -32,6 +32,8 @@ Aabb2 bounds(std::span<const Vec2> polygon);
 // Even-odd rule; points exactly on the boundary may go either way.
 bool point_in_polygon(std::span<const Vec2> polygon, const Vec2& p);
 double distance_to_segment(const Vec2& p, const Vec2& a, const Vec2& b);
+// The squared distance from p to the segment ab.
+double squared_distance_to_segment(const Vec2& p, const Vec2& a, const Vec2& b);
 double distance_to_boundary(std::span<const Vec2> polygon, const Vec2& p);
 // True when no two non-adjacent edges intersect (O(n^2), for validating input polygons).
 bool is_simple_polygon(std::span<const Vec2> polygon);

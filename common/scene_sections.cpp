@@ -149,7 +149,8 @@ void read_tool(Fields& f, Scene& s) {
     t.rim.width_m = f.number("tool.rim_width_m",
                              0.5 * (t.shape == ToolShape::Disk ? t.radius_m : t.half_size_m.minCoeff()), tool_size);
     t.rim.forward_bias = f.number("tool.rim_forward_bias", 0.8, closed(0.0, 1.0));
-    t.rim.model = *displacement_from(f.choice("tool.displacement", "bulldoze", {"rim", "bulldoze"}));
+    t.rim.model = *displacement_from(f.choice("tool.displacement", "carry", {"rim", "bulldoze", "carry"}));
+    t.rim.carry_shed_fraction = f.number("tool.carry_shed_fraction", 0.0, closed(0.0, 1.0));
     t.rim.tan_repose = s.material.tan_critical();  // the front pile stands at the material's angle
   }
 

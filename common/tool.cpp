@@ -16,8 +16,8 @@ constexpr std::pair<ToolShape, std::string_view> kShapeNames[] = {{ToolShape::Di
                                                                   {ToolShape::Pour, "pour"}};
 constexpr std::pair<BottomProfile, std::string_view> kProfileNames[] = {{BottomProfile::Flat, "flat"},
                                                                         {BottomProfile::SphereCap, "sphere_cap"}};
-constexpr std::pair<Displacement, std::string_view> kDisplacementNames[] = {{Displacement::Rim, "rim"},
-                                                                            {Displacement::Bulldoze, "bulldoze"}};
+constexpr std::pair<Displacement, std::string_view> kDisplacementNames[] = {
+    {Displacement::Rim, "rim"}, {Displacement::Bulldoze, "bulldoze"}, {Displacement::Carry, "carry"}};
 
 template <typename Enum, std::size_t N>
 std::string name_of(const std::pair<Enum, std::string_view> (&table)[N], Enum e) {
@@ -66,6 +66,8 @@ std::optional<std::string> ToolSpec::problem() const {
   if (!p && !(rim.width_m >= 0.0)) p = "tool.rim_width_m = " + number(rim.width_m) + " must be >= 0";
   if (!p && !(rim.forward_bias >= 0.0 && rim.forward_bias <= 1.0))
     p = "tool.rim_forward_bias = " + number(rim.forward_bias) + " must be in [0, 1]";
+  if (!p && !(rim.carry_shed_fraction >= 0.0 && rim.carry_shed_fraction <= 1.0))
+    p = "tool.carry_shed_fraction = " + number(rim.carry_shed_fraction) + " must be in [0, 1]";
   return p;
 }
 

@@ -14,8 +14,9 @@ namespace sb {
 enum class ToolShape { Disk, Box, Ellipse, Polygon, Pour };
 enum class BottomProfile { Flat, SphereCap };
 // Where a moving tool puts the sand it cuts: a rim band around the footprint (the paper's
-// related work), or the band ahead of it only, as a blade does (bulldozing).
-enum class Displacement { Rim, Bulldoze };
+// related work), the band ahead of it only, as a blade does (bulldozing), or a pile ahead of it
+// and around its front that the tool carries from stamp to stamp, shedding part of it (carry).
+enum class Displacement { Rim, Bulldoze, Carry };
 
 // Names as in scene files and sessions ("disk", "sphere_cap"), one table each way.
 std::string to_string(ToolShape s);
@@ -23,7 +24,7 @@ std::string to_string(BottomProfile p);
 std::string to_string(Displacement d);
 std::optional<ToolShape> tool_shape_from(std::string_view name);          // disk | box | ellipse | polygon | pour
 std::optional<BottomProfile> bottom_profile_from(std::string_view name);  // flat | sphere_cap
-std::optional<Displacement> displacement_from(std::string_view name);     // rim | bulldoze
+std::optional<Displacement> displacement_from(std::string_view name);     // rim | bulldoze | carry
 
 // Where the displaced volume goes. `Rim`: a band just outside the footprint, all around it,
 // weighted towards the direction of motion (Sumner et al. 1999; Onoue & Nishita 2003).
@@ -31,13 +32,19 @@ std::optional<Displacement> displacement_from(std::string_view name);     // rim
 // whose back part the next stamp cuts again, so the sand is carried with the tool as a growing
 // front pile that spills forward and to the sides (the earthmoving models of Holz et al.
 // 2009); a stamp that does not move, or whose pile would lie off the domain, uses the rim.
+// `Carry`: the same pile, spread around the tool's front as well as ahead, and carried: each
+// stamp picks up the pile the stamp before it left, less the part it sheds, and heaps it again
+// with its own cut (common/front_pile.hpp).
 struct RimRule {
   double width_m = 0.01;                   // band width outside the footprint boundary
   double forward_bias = 0.8;               // rim: 0 uniform; 1 nothing behind the tool
-  Displacement model = Displacement::Rim;  // scenes default to Bulldoze (tool.displacement)
+  Displacement model = Displacement::Rim;  // scenes default to Carry (tool.displacement)
   // Bulldoze: the slope the front pile stands at, the material's critical slope (scenes set it
   // from material.critical_angle_deg; this default is the material's default, 30 degrees).
   double tan_repose = 0.57735026918962573;
+  // Carry: the fraction of its pile a tool leaves behind per its own length travelled (0: the
+  // berms are only what erosion spills off the carried pile's flanks, as the particles show).
+  double carry_shed_fraction = 0.0;
 };
 
 struct ToolSpec {
@@ -87,8 +94,10 @@ struct ToolStamp {
   bool is_pour() const { return pour_volume_m3 > 0.0; }
   // Whether the cut sand goes to a front pile (common/front_pile.hpp) rather than the rim.
   bool bulldozes() const {
-    return rim.model == Displacement::Bulldoze && motion_dir.squaredNorm() > 0.0 && !footprint.empty();
+    return rim.model != Displacement::Rim && motion_dir.squaredNorm() > 0.0 && !footprint.empty();
   }
+  // Whether the pile is carried from stamp to stamp (Displacement::Carry).
+  bool carries() const { return bulldozes() && rim.model == Displacement::Carry; }
   // Height of the tool bottom at p (meaningful inside the footprint).
   double bottom_z(const Vec2& p) const;
   bool contains(const Vec2& p) const { return point_in_polygon(footprint, p); }

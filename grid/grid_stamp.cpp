@@ -4,7 +4,9 @@
 
 namespace sb::grid {
 
-template StampReport stamp_grid<HeightGrid<float>>(HeightGrid<float>&, const ToolStamp&, std::vector<std::uint32_t>&);
-template StampReport stamp_grid<HeightGrid<double>>(HeightGrid<double>&, const ToolStamp&, std::vector<std::uint32_t>&);
+template StampReport stamp_grid<HeightGrid<float>>(HeightGrid<float>&, const ToolStamp&, std::vector<std::uint32_t>&,
+                                                   CarriedNodes*);
+template StampReport stamp_grid<HeightGrid<double>>(HeightGrid<double>&, const ToolStamp&, std::vector<std::uint32_t>&,
+                                                    CarriedNodes*);
 
 }  // namespace sb::grid

@@ -68,6 +68,8 @@ class GridTerrainBase : public Terrain {
   const Heights& heights() const { return heights_; }
   const Active& active_set() const { return active_; }
   const Stencil& stencil() const { return stencil_; }
+  // The pile the last stamp heaped, if it carries it on (tool.displacement = "carry").
+  const CarriedNodes& carried_pile() const { return carried_; }
 
  protected:
   // neighbours: 4 or 8; idle_passes: idle visits before a node leaves the active set.
@@ -86,13 +88,14 @@ class GridTerrainBase : public Terrain {
   unsigned threads_ = 1;
   bool multires_ = true;
   std::optional<ErosionTables> tables_;  // built on the first erode, rebuilt when the rule changes
+  CarriedNodes carried_;                 // the pile a carrying stamp left for the next
 };
 
 template <class Heights, class Active>
 StampReport GridTerrainBase<Heights, Active>::stamp(const ToolStamp& s) {
   std::vector<std::uint32_t> changed;
   const double carry_before = heights_.carry_m3();
-  StampReport report = stamp_grid(heights_, s, changed);
+  StampReport report = stamp_grid(heights_, s, changed, &carried_);
   // What the stored volume changed by: the stamp's own sums, less what rounding put into
   // the carry (zero in double).
   report.volume_change_m3 =
@@ -150,7 +153,8 @@ template <class Heights, class Active>
 ModelStats GridTerrainBase<Heights, Active>::stats() const {
   ModelStats st;
   st.cells = heights_.layout().nodes();
-  st.bytes = heights_.bytes() + active_.bytes() + (tables_ ? tables_->bytes() : 0);
+  st.bytes = heights_.bytes() + active_.bytes() + (tables_ ? tables_->bytes() : 0) +
+             carried_.base.capacity() * sizeof(carried_.base[0]);
   st.active = active_.size();
   return st;
 }

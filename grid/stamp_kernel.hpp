@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "common/bilinear.hpp"
@@ -16,6 +17,7 @@
 #include "common/terrain.hpp"
 #include "grid/compensated_sum.hpp"
 #include "grid/grid_layout.hpp"
+#include "grid/grid_stamp.hpp"
 
 namespace sb::grid {
 
@@ -100,16 +102,7 @@ std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, con
                                       double volume) {
   const GridLayout& layout = grid.layout();
   const double tan = s.rim.tan_repose;
-  const Vec2 dir = s.motion_dir, across(-dir.y(), dir.x());
-  // A node of the pile lies ahead of the pose by at most the footprint's front plus the reach.
-  double front = 0.0;
-  for (const Vec2& v : s.footprint) front = std::max(front, (v - s.pose.xy).dot(dir));
   const double margin = 0.5 * std::min(layout.dx, layout.dy);  // rounding at the corridor's edges
-  const auto corridor = [&](double reach) {
-    const Vec2 side = s.half_width_m * across, ahead = (front + reach) * dir;
-    const Vec2 a = s.pose.xy + side, b = s.pose.xy - side, c = a + ahead, d = b + ahead;
-    return Aabb2{a.cwiseMin(b).cwiseMin(c).cwiseMin(d), a.cwiseMax(b).cwiseMax(c).cwiseMax(d)}.expanded(margin);
-  };
   const double outer = std::sqrt(circles.outer2);
   double reach = std::max({front_pile_flat_reach(volume, 2.0 * s.half_width_m, tan), s.rim.width_m, layout.diagonal()});
   std::vector<std::uint32_t> nodes;
@@ -119,7 +112,7 @@ std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, con
   for (int round = 0; round < 64; ++round) {
     nodes.clear();
     samples.clear();
-    const NodeRange r = layout.nodes_in(corridor(reach));
+    const NodeRange r = layout.nodes_in(front_pile_box(s, reach, margin));
     double lowest = HUGE_VAL;
     for (std::size_t iy = r.y0; !r.empty && iy <= r.y1; ++iy) {
       for (std::size_t ix = r.x0; ix <= r.x1; ++ix) {
@@ -128,7 +121,7 @@ std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, con
         const double d2 = (p - circles.centre).squaredNorm();
         if (d2 < circles.inner2 || (d2 <= circles.outer2 && s.contains(p))) continue;
         if (std::sqrt(d2) - outer > reach) continue;  // a lower bound of its distance to the footprint
-        const double d = distance_to_boundary(s.footprint, p);
+        const double d = pile_distance(s, p);
         if (d > reach) continue;
         const std::uint32_t k = layout.index(ix, iy);
         nodes.push_back(k);
@@ -155,10 +148,35 @@ std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, con
   return {};
 }
 
+// A carrying stamp picks up what it keeps of the pile the stamp before it heaped (front_pile.hpp),
+// at the nodes outside its footprint (the footprint's it cuts whole). The volume it took.
 template <class Store>
-StampReport cut_and_push(Store& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed) {
+double pick_up_carried(Store& grid, const ToolStamp& s, const FootprintCircles& circles, const CarriedNodes& carried,
+                       std::vector<std::uint32_t>& changed) {
+  const double keep = carried_fraction(s, carried.origin);
+  if (!(keep > 0.0)) return 0.0;
+  const GridLayout& layout = grid.layout();
+  CompensatedSum taken;
+  for (const auto& [k, base] : carried.base) {
+    const auto [ix, iy] = layout.split(k);
+    const Vec2 p = layout.position(ix, iy);
+    const double d2 = (p - circles.centre).squaredNorm();
+    if (d2 < circles.inner2 || (d2 <= circles.outer2 && s.contains(p))) continue;
+    const double z = grid.z(k), dz = keep * (z - base);
+    if (!(dz > 0.0)) continue;
+    grid.set(k, z - dz);
+    taken.add(layout.area(k) * dz);
+    changed.push_back(k);
+  }
+  return taken.value();
+}
+
+template <class Store>
+StampReport cut_and_push(Store& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed, CarriedNodes* carried) {
   const GridLayout& layout = grid.layout();
   StampReport report;
+  // Whatever this stamp does, the pile it may leave for the next one is set below or none.
+  const CarriedNodes previous = carried ? std::exchange(*carried, CarriedNodes{}) : CarriedNodes{};
   if (s.footprint.size() < 3) return report;
   const NodeRange r = layout.nodes_in(s.influence_bounds());
   if (r.empty) return report;
@@ -185,13 +203,21 @@ StampReport cut_and_push(Store& grid, const ToolStamp& s, std::vector<std::uint3
     }
   };
   scan(true);
-  if (cuts.empty()) return report;
+  // What a carrying stamp picks up lies outside the footprint, so the cuts are the same before and after.
+  const double picked = pick_up_carried(grid, s, circles, previous, changed);
+  if (cuts.empty() && !(picked > 0.0)) return report;
   CompensatedSum removed;
+  removed.add(picked);
   for (const Cut& c : cuts) removed.add(layout.area(c.node) * (grid.z(c.node) - c.bottom_z));
   const double volume = removed.value();
   // A bulldozing stamp's sand goes ahead of the tool; the rim takes it when nothing lies ahead
   // (the tool at the domain's far side) and for every other stamp.
   if (s.bulldozes()) rim = front_pile_nodes(grid, s, circles, volume);
+  if (carried && s.carries() && !rim.empty()) {
+    carried->origin = carried_origin(s);
+    carried->base.reserve(rim.size());
+    for (const Deposit& d : rim) carried->base.emplace_back(d.node, grid.z(d.node));
+  }
   if (rim.empty()) scan(false);
   if (rim.empty()) rim = widened_rim(layout, s);
   // No node outside the footprint (a tool larger than the domain): cutting would lose
@@ -288,8 +314,12 @@ StampReport pour(Store& grid, const ToolStamp& s, std::vector<std::uint32_t>& ch
 }  // namespace stamp_detail
 
 template <class Store>
-StampReport stamp_grid(Store& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed) {
-  return s.is_pour() ? stamp_detail::pour(grid, s, changed) : stamp_detail::cut_and_push(grid, s, changed);
+StampReport stamp_grid(Store& grid, const ToolStamp& s, std::vector<std::uint32_t>& changed, CarriedNodes* carried) {
+  if (s.is_pour()) {
+    if (carried) *carried = CarriedNodes{};
+    return stamp_detail::pour(grid, s, changed);
+  }
+  return stamp_detail::cut_and_push(grid, s, changed, carried);
 }
 
 }  // namespace sb::grid

@@ -36,8 +36,7 @@ void TinTerrain::fill_pile_lattice(const StampWork& w, double reach, StampReport
     for (long i = first(0); i <= last(0); ++i) {
       const Vec2 p = box_.lo + h * Vec2(static_cast<double>(i), static_cast<double>(j));
       if (!inner.contains(p) || !in_front_pile(s, p) || s.contains(p)) continue;
-      const double d = distance_to_boundary(s.footprint, p);
-      if (d > reach || d < w.gap + clear) continue;
+      if (distance_to_boundary(s.footprint, p) < w.gap + clear || pile_distance(s, p) > reach) continue;
       const Location loc = locate(p);
       bool near = false;
       for (int k = 0; k < 3; ++k) {
@@ -71,7 +70,7 @@ bool TinTerrain::deposit_front_pile(StampWork& w, double deposit, StampReport& r
     for (VertexHandle v : found) {
       const Vec2 p = xy(v);
       if (!in_front_pile(s, p) || w.in_footprint(p)) continue;
-      const double d = distance_to_boundary(s.footprint, p);
+      const double d = pile_distance(s, p);
       if (d > reach) continue;
       pile.push_back(v);
       samples.push_back({d, v->point().z(), cached_area(v)});
@@ -89,14 +88,36 @@ bool TinTerrain::deposit_front_pile(StampWork& w, double deposit, StampReport& r
   double weight_sum = 0.0;
   for (const PileSample& p : samples) weight_sum += front_pile_depth(p, level, tan) * p.area_m2;
   if (!(weight_sum > 0.0)) return false;
+  if (s.carries()) carried_origin_ = carried_origin(s);
   for (std::size_t i = 0; i < pile.size(); ++i) {
     const double depth = front_pile_depth(samples[i], level, tan);
     if (!(depth > 0.0)) continue;
-    const double a = samples[i].area_m2;
-    shift_z(pile[i], pile[i]->point().z() + deposit * (depth / weight_sum), a);
+    const double a = samples[i].area_m2, z = pile[i]->point().z();
+    if (s.carries()) carried_.emplace_back(xy(pile[i]), z);
+    shift_z(pile[i], z + deposit * (depth / weight_sum), a);
     w.changed.push_back(pile[i]);
   }
   return true;
+}
+
+double TinTerrain::pick_up_carried(StampWork& w, const CarriedPileOrigin& origin,
+                                   const std::vector<std::pair<Vec2, double>>& base) {
+  const double keep = carried_fraction(w.tool, origin);
+  if (!(keep > 0.0)) return 0.0;
+  double taken = 0.0;
+  for (const auto& [p, z_base] : base) {
+    if (w.in_footprint(p)) continue;  // cut whole by this stamp
+    const Location loc = locate(p);
+    if (loc.type != Cdt::VERTEX) continue;  // removed by a retriangulation since
+    const VertexHandle v = loc.face->vertex(loc.index);
+    const double z = v->point().z(), dz = keep * (z - z_base);
+    if (!(dz > 0.0)) continue;
+    const double before = volume_change_;
+    shift_z(v, z - dz, cached_area(v));
+    taken -= volume_change_ - before;  // the measured change, as shift_z booked it
+    w.changed.push_back(v);
+  }
+  return taken;
 }
 
 }  // namespace sb::tin::detail

@@ -176,6 +176,9 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   // dropped, so the surface between old stamps is free to relax and coarsen (the Delaunay
   // triangulation minimises roughness, Rippa 1990).
   volume_change_ = 0.0;
+  // The pile the stamp before left: this stamp carries it on or not, and leaves its own or none.
+  const CarriedPileOrigin carried_origin = std::exchange(carried_origin_, CarriedPileOrigin{});
+  const std::vector<std::pair<Vec2, double>> carried = std::exchange(carried_, {});
   std::vector<VertexHandle> stale_region;
   const double unconstrained = drop_stale_constraints(s.generation, stale_region);
   volume_change_ += unconstrained;
@@ -212,11 +215,12 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   for (VertexHandle v : region_vertices) forget_caches(v);
 
   // 1d (cont.): the displaced volume, and what the retriangulation changed (tin.conserve_volume).
-  const double deposit = w.lowered_volume - (spec_.conserve_volume ? surface_change : 0.0) - stale_delta_;
+  const double picked = pick_up_carried(w, carried_origin, carried);
+  const double deposit = picked + w.lowered_volume - (spec_.conserve_volume ? surface_change : 0.0) - stale_delta_;
   // (An uncut stamp that lowered nothing leaves the mesh as it was: no rim to refine.)
   report.volume_deposited_m3 = w.cut || deposit != 0.0 ? deposit_on_rim(w, deposit, report) : 0.0;
   activate(w, region_vertices);  // 1f
-  report.volume_removed_m3 = w.lowered_volume;
+  report.volume_removed_m3 = w.lowered_volume + picked;
   report.elements_touched = measured.faces_after;
   report.volume_change_m3 = volume_change_;
   return report;

@@ -64,7 +64,8 @@ ModelStats TinTerrain::stats() const {
            vector_bytes(transfer_scratch_) + vector_bytes(vertex_scratch_) + vector_bytes(face_scratch_) +
            vector_bytes(link_scratch_) + vector_bytes(work_scratch_) + vector_bytes(redundant_scratch_) +
            vector_bytes(link_hold_scratch_) + vector_bytes(ring_pool_) + vector_bytes(ring_scratch_) +
-           vector_bytes(diagonal_scratch_) + vector_bytes(link_z_scratch_) + vector_bytes(link_area_scratch_);
+           vector_bytes(diagonal_scratch_) + vector_bytes(link_z_scratch_) + vector_bytes(link_area_scratch_) +
+           vector_bytes(carried_);
   st.bytes = bytes;
   return st;
 }

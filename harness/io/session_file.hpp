@@ -74,7 +74,7 @@ void validate_session(const Session& session, const Scene& scene, const std::str
 // The stamps of a session as a lazy schedule (generations renumbered from 0): keeps a copy of
 // the poses, O(stamps) small records; footprints are built when a stamp is asked for. Sessions
 // record the tools' shapes and rims, not where a tool puts the sand it cuts: every tool takes
-// the displacement model and its front pile's slope of `scene_tool` (the scene replayed on,
+// the displacement model, its front pile's slope and its shed fraction of `scene_tool` (the scene replayed on,
 // as the live session took them from its scene).
 StampSchedule session_schedule(const Session& session, const ToolSpec& scene_tool);
 

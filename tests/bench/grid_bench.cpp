@@ -4,13 +4,15 @@
 // in-place sweep of the same rule in the same run (BM_ReferenceSweep), against a vectorised
 // two-pass (Jacobi) sweep at its monotone fraction (BM_JacobiSweep), time to rest of both
 // orders (BM_Settle*), stamp cost against tool area (BM_Stamp: the rim; BM_BulldozeStroke: a
-// stroke carrying its front pile); float and double; the pile and stroke also with the gradient rule.
+// stroke pushing its front pile, bulldozing or carrying it); float and double; the pile and
+// stroke also with the gradient rule.
 //
 //   build/<dir>/tests/grid_bench --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 //       --benchmark_enable_random_interleaving=true
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdint>
 #include <numbers>
 #include <span>
 #include <vector>
@@ -453,15 +455,18 @@ BENCHMARK(BM_Stamp<double>)->ArgName("radius_cells")->RangeMultiplier(2)->Range(
 
 // A bulldozing stroke (common/front_pile.hpp): a disk of the given radius (in cells) pulled 12
 // radii along x, a stamp every quarter radius as in the shipped scenes, so the front pile grows
-// and is carried as in a real stroke; time per stamp. The grid is reset (untimed) per stroke.
+// and is carried as in a real stroke; time per stamp. carry = 1: tool.displacement = "carry"
+// (each stamp also picks up the pile the one before heaped). The grid is reset (untimed) per stroke.
 template <class Real>
 void BM_BulldozeStroke(benchmark::State& state) {
   const double radius = static_cast<double>(state.range(0)) * kCell;
   sb::ToolSpec spec = disk(radius, 0.01);
-  spec.rim.model = sb::Displacement::Bulldoze;
+  spec.rim.model = state.range(1) ? sb::Displacement::Carry : sb::Displacement::Bulldoze;
   std::vector<sb::ToolStamp> stamps;
-  for (int i = 0; i <= 48; ++i)
+  for (int i = 0; i <= 48; ++i) {
     stamps.push_back(stamp_at(spec, {2.0 * radius + 0.25 * radius * i, 0.5 * kSize}, {1.0, 0.0}));
+    stamps.back().generation = static_cast<std::uint32_t>(i);
+  }
   const GridTerrain<Real> fresh = flat_grid<Real>();
   GridTerrain<Real> t = fresh;
   std::size_t next = 0;
@@ -481,9 +486,8 @@ void BM_BulldozeStroke(benchmark::State& state) {
   state.counters["nodes_touched"] = benchmark::Counter(touched, benchmark::Counter::kAvgIterations);
 }
 BENCHMARK(BM_BulldozeStroke<double>)
-    ->ArgName("radius_cells")
-    ->RangeMultiplier(2)
-    ->Range(4, 32)
+    ->ArgNames({"radius_cells", "carry"})
+    ->ArgsProduct({{4, 8, 16, 32}, {0, 1}})
     ->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -106,6 +106,44 @@ TEST(FrontPile, OnlyAheadOfThePoseOnAnyHeading) {
   EXPECT_GT(still.rim_weight({-0.012, 0.0}), 0.0);
 }
 
+// A carrying stamp's pile also takes the points beside the tool back to its rear, but not the
+// trench behind the pose within its width; its distance is from the faces that meet the motion,
+// so beside the tool it grows towards the rear. It carries on the pile of the stamp just before
+// it, keeping (1 - shed)^(moved / length), and no other.
+TEST(FrontPile, CarriedBesideTheToolFromStampToStamp) {
+  ToolSpec t;
+  t.shape = ToolShape::Box;
+  t.half_size_m = {0.01, 0.015};  // 2 cm along the motion, 3 cm across
+  t.rim.model = Displacement::Carry;
+  t.rim.carry_shed_fraction = 0.35;
+  for (const double heading : {0.0, 0.6, 2.0, -2.5}) {
+    const Vec2 dir(std::cos(heading), std::sin(heading)), across(-dir.y(), dir.x());
+    const Vec2 centre(0.3, -0.2);
+    const ToolStamp s = make_stamp(t, {centre, 0.0, heading}, dir, 7);
+    EXPECT_TRUE(s.bulldozes() && s.carries());
+    const auto point = [&](double along, double side) { return Vec2(centre + along * dir + side * across); };
+    EXPECT_TRUE(in_front_pile(s, point(0.05, 0.03))) << heading;                      // ahead, beside the width
+    EXPECT_TRUE(in_front_pile(s, point(-0.008, 0.02))) << heading;                    // beside the rear half
+    EXPECT_FALSE(in_front_pile(s, point(-0.012, 0.02))) << heading;                   // behind the rear
+    EXPECT_FALSE(in_front_pile(s, point(-0.005, 0.0))) << heading;                    // behind the pose, in the width
+    EXPECT_NEAR(pile_distance(s, point(0.03, 0.0)), 0.02, 1e-12) << heading;          // from the front face
+    EXPECT_NEAR(pile_distance(s, point(0.0, 0.02)), std::hypot(0.01, 0.005), 1e-12);  // from its corner
+    EXPECT_NEAR(pile_distance(s, point(-0.008, 0.02)), std::hypot(0.018, 0.005), 1e-12);
+
+    const CarriedPileOrigin before = carried_origin(make_stamp(t, {point(-0.002, 0.0), 0.0, heading}, dir, 6));
+    EXPECT_NEAR(carried_fraction(s, before), std::pow(0.65, 0.002 / 0.02), 1e-12) << heading;
+    EXPECT_EQ(carried_fraction(make_stamp(t, {centre, 0.0, heading}, dir, 8), before), 0.0);  // not the next
+    const CarriedPileOrigin far = carried_origin(make_stamp(t, {point(-0.03, 0.0), 0.0, heading}, dir, 6));
+    EXPECT_EQ(carried_fraction(s, far), 0.0);  // the tool moved more than its length: a new pile
+  }
+  ToolSpec bulldoze = t;
+  bulldoze.rim.model = Displacement::Bulldoze;
+  const ToolStamp b = make_stamp(bulldoze, {{0.0, 0.0}, 0.0, 0.0}, {1.0, 0.0}, 1);
+  EXPECT_FALSE(b.carries());
+  EXPECT_FALSE(carried_origin(b).valid);
+  EXPECT_EQ(carried_fraction(b, carried_origin(make_stamp(t, {{-0.002, 0.0}, 0.0, 0.0}, {1.0, 0.0}, 0))), 0.0);
+}
+
 // The level holds exactly the volume asked for over the samples given, whatever their order,
 // including samples the pile does not reach; on flat ground it is a ramp at the repose slope.
 TEST(FrontPile, LevelHoldsTheVolumeExactly) {

@@ -2,7 +2,8 @@
 // of a widening corridor ahead of the tool and skips the polygon distance where the footprint's
 // circles decide. Its pile must equal the one the same widening finds by testing every node of
 // the grid: disks, boxes and a concave polygon, on axis-aligned and oblique headings, tools
-// smaller than a cell, rough sand, a pile that runs off the grid.
+// smaller than a cell, rough sand, a pile that runs off the grid; bulldozing (the corridor) and
+// carrying (beside the tool too, the distance from its front face).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -36,7 +37,7 @@ std::map<std::uint32_t, double> pile_over_every_node(const HeightGrid<double>& g
       for (std::size_t ix = 0; ix < layout.nx; ++ix) {
         const Vec2 p = layout.position(ix, iy);
         if (!in_front_pile(s, p) || s.contains(p)) continue;
-        const double d = distance_to_boundary(s.footprint, p);
+        const double d = pile_distance(s, p);
         if (d > reach) continue;
         const std::uint32_t k = layout.index(ix, iy);
         nodes.push_back(k);
@@ -58,13 +59,13 @@ std::map<std::uint32_t, double> pile_over_every_node(const HeightGrid<double>& g
   return {};
 }
 
-ToolSpec tool(ToolShape shape, double size_m) {
+ToolSpec tool(ToolShape shape, double size_m, Displacement model) {
   ToolSpec spec;
   spec.shape = shape;
   spec.radius_m = size_m;
   spec.half_size_m = {0.5 * size_m, size_m};
   spec.polygon_m = {{-size_m, -size_m}, {size_m, -size_m}, {size_m, size_m}, {0.0, 0.2 * size_m}, {-size_m, size_m}};
-  spec.rim.model = Displacement::Bulldoze;
+  spec.rim.model = model;
   spec.rim.width_m = 0.5 * size_m;
   return spec;
 }
@@ -76,33 +77,34 @@ TEST(GridFrontPile, TheCorridorFindsThePileOfEveryNodeAhead) {
   std::uniform_real_distribution<double> rough(0.0, 0.003);
   const HeightGrid<double> grid(layout, [&](const Vec2&) { return 0.05 + rough(rng); });
   int compared = 0;
-  for (const ToolShape shape : {ToolShape::Disk, ToolShape::Box, ToolShape::Polygon}) {
-    for (const double size : {0.0007, 0.004, 0.015}) {  // under a cell, a few cells, many
-      for (const double heading_deg : {0.0, 90.0, 45.0, 200.0, 301.7}) {
-        for (const Vec2& xy : {Vec2(0.1, 0.08), Vec2(0.185, 0.15)}) {  // mid-grid; the pile off the grid
-          for (const double volume : {1e-9, 2e-6, 4e-5}) {
-            const double a = heading_deg * std::numbers::pi / 180.0;
-            const Vec2 dir(std::cos(a), std::sin(a));
-            ToolPose pose;
-            pose.xy = xy;
-            pose.bottom_z = 0.04;
-            pose.heading_rad = a;
-            const ToolStamp s = make_stamp(tool(shape, size), pose, dir, 0);
-            const std::vector<Deposit> found = front_pile_nodes(grid, s, FootprintCircles(s), volume);
-            const std::map<std::uint32_t, double> expected = pile_over_every_node(grid, s, volume);
-            ASSERT_EQ(found.size(), expected.size()) << static_cast<int>(shape) << " " << size << " " << heading_deg;
-            for (const Deposit& d : found) {
-              const auto e = expected.find(d.node);
-              ASSERT_NE(e, expected.end()) << "node " << d.node << " is not under the pile";
-              EXPECT_NEAR(d.weight, e->second, 1e-12) << "node " << d.node;
+  for (const Displacement model : {Displacement::Bulldoze, Displacement::Carry})
+    for (const ToolShape shape : {ToolShape::Disk, ToolShape::Box, ToolShape::Polygon}) {
+      for (const double size : {0.0007, 0.004, 0.015}) {  // under a cell, a few cells, many
+        for (const double heading_deg : {0.0, 90.0, 45.0, 200.0, 301.7}) {
+          for (const Vec2& xy : {Vec2(0.1, 0.08), Vec2(0.185, 0.15)}) {  // mid-grid; the pile off the grid
+            for (const double volume : {1e-9, 2e-6, 4e-5}) {
+              const double a = heading_deg * std::numbers::pi / 180.0;
+              const Vec2 dir(std::cos(a), std::sin(a));
+              ToolPose pose;
+              pose.xy = xy;
+              pose.bottom_z = 0.04;
+              pose.heading_rad = a;
+              const ToolStamp s = make_stamp(tool(shape, size, model), pose, dir, 0);
+              const std::vector<Deposit> found = front_pile_nodes(grid, s, FootprintCircles(s), volume);
+              const std::map<std::uint32_t, double> expected = pile_over_every_node(grid, s, volume);
+              ASSERT_EQ(found.size(), expected.size()) << static_cast<int>(shape) << " " << size << " " << heading_deg;
+              for (const Deposit& d : found) {
+                const auto e = expected.find(d.node);
+                ASSERT_NE(e, expected.end()) << "node " << d.node << " is not under the pile";
+                EXPECT_NEAR(d.weight, e->second, 1e-12) << "node " << d.node;
+              }
+              ++compared;
             }
-            ++compared;
           }
         }
       }
     }
-  }
-  EXPECT_EQ(compared, 3 * 3 * 5 * 2 * 3);
+  EXPECT_EQ(compared, 2 * 3 * 3 * 5 * 2 * 3);
 }
 
 }  // namespace

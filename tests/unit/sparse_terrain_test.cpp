@@ -67,12 +67,13 @@ TEST_P(SparseAgainstDense, SameHeightsBitForBitInLessMemory) {
 }
 
 // Memory bounds: what this design reaches (measured: flat_stroke 0.16, pile 0.19, trench
-// 0.39 -- a quarter of the trench's domain is disturbed, and a disturbed node costs 8.6
+// 0.49 -- the carried pile's flanks disturb more of the trench's domain (0.39 when the pile
+// was heaped only in the corridor ahead), and a disturbed node costs 8.6
 // bytes against the dense grid's 10.1, besides the 14 KB of erosion tables both carry --
 // dunes, where every node differs, 0.95).
 INSTANTIATE_TEST_SUITE_P(Shipped, SparseAgainstDense,
                          ::testing::Values(Case{"flat_stroke", {}, 0.2}, Case{"pile", {}, 0.2},
-                                           Case{"trench", {}, 0.45}, Case{"dunes", {}, 1.0},
+                                           Case{"trench", {}, 0.55}, Case{"dunes", {}, 1.0},
                                            Case{"flat_stroke", {"grid.storage=\"float\"", "grid.neighbours=4"}, 0.3},
                                            Case{"pile", {"grid.storage=\"float\""}, 0.3}),
                          [](const ::testing::TestParamInfo<Case>& info) {

@@ -4,6 +4,10 @@
 // mesh's integrity, the pile never steeper than the repose slope along the motion (it stood as a
 // column many times the cut depth when the sand went to a band of fixed width), nothing raised
 // behind the stroke's start; and the pile the same on every heading.
+// Carrying (tool.displacement = "carry") on the same strokes: volume and integrity as above, the
+// pile heaped around the blade's front carried to the stroke's end (a tool that sheds nothing
+// arrives with the sand it cut, less what erosion spilled), the berms it leaves growing with
+// what it sheds, and the same on every heading.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -28,13 +32,15 @@ constexpr double kDepth = 0.015;  // the blade's cut, in 25 mm of sand
 constexpr double kBed = 0.025;
 constexpr double kLength = 0.12;  // of the stroke
 
-// A 2 cm (along the motion) x 3 cm box dragged kLength from `start` toward `heading_deg`.
-std::string blade_scene(const Vec2& start, double heading_deg) {
+// A 2 cm (along the motion) x 3 cm box dragged kLength from `start` toward `heading_deg`;
+// `displacement`: the [tool] keys that choose where the cut sand goes.
+std::string blade_scene(const Vec2& start, double heading_deg,
+                        const std::string& displacement = "displacement = \"bulldoze\"\n") {
   const double a = heading_deg * std::numbers::pi / 180.0;
   const Vec2 end = start + kLength * Vec2(std::cos(a), std::sin(a));
   return test::flat_sand_scene(
       "0.3", std::to_string(kBed),
-      "shape = \"box\"\nsize_m = [0.02, 0.03]\ndepth_m = " + std::to_string(kDepth) + "\ndisplacement = \"bulldoze\"\n",
+      "shape = \"box\"\nsize_m = [0.02, 0.03]\ndepth_m = " + std::to_string(kDepth) + "\n" + displacement,
       "[stroke]\npath_m = [[" + std::to_string(start.x()) + ", " + std::to_string(start.y()) + "], [" +
           std::to_string(end.x()) + ", " + std::to_string(end.y()) +
           "]]\nspacing_m = 0.002\n[grid]\ncell_m = 0.002\n[tin]\nrefine_m = 0.002\n");
@@ -46,11 +52,14 @@ class Bulldoze : public ::testing::Test {
   struct Outcome {
     double pile_height_m = 0.0;   // highest point ahead of the blade at the end, above the bed
     double steepest_ahead = 0.0;  // steepest fall along the motion ahead of the blade, any stamp
+    double pile_volume_m3 = 0.0;  // above the bed, ahead of the pose at the end
+    double berm_m = 0.0;          // highest point beside the trench's middle third, above the bed
   };
 
-  Outcome drag(const Vec2& start, double heading_deg) const {
+  Outcome drag(const Vec2& start, double heading_deg,
+               const std::string& displacement = "displacement = \"bulldoze\"\n") const {
     std::vector<std::string> overrides = Backend::overrides();
-    const Scene s = parse_scene(blade_scene(start, heading_deg), "bulldoze", overrides);
+    const Scene s = parse_scene(blade_scene(start, heading_deg, displacement), "bulldoze", overrides);
     auto t = make_terrain(Backend::kName, s, HeightField::from_scene(s));
     const double v0 = t->volume();
     const double a = heading_deg * std::numbers::pi / 180.0;
@@ -78,6 +87,15 @@ class Bulldoze : public ::testing::Test {
     for (double side = -0.03; side <= 0.03; side += 0.002)
       for (double ahead = 0.011; ahead < 0.1; ahead += 0.002)
         out.pile_height_m = std::max(out.pile_height_m, t->height(last.pose.xy + ahead * dir + side * across) - kBed);
+    constexpr double kStep = 0.001;
+    for (double side = -0.08; side <= 0.08; side += kStep)
+      for (double ahead = 0.5 * kStep; ahead < 0.12; ahead += kStep)
+        out.pile_volume_m3 +=
+            kStep * kStep * std::max(0.0, t->height(last.pose.xy + ahead * dir + side * across) - kBed);
+    for (double along = kLength / 3; along <= 2 * kLength / 3; along += 0.002)
+      for (double side = 0.016; side <= 0.04; side += 0.001)
+        for (double sign : {-1.0, 1.0})
+          out.berm_m = std::max(out.berm_m, t->height(start + along * dir + sign * side * across) - kBed);
     // Behind the start (beyond the rim's reach too): no sand put there. (The TIN's large flat
     // triangles there lean toward the vertices of the trench and its berms by some microns.)
     for (double side = -0.03; side <= 0.03; side += 0.005)
@@ -101,6 +119,40 @@ TYPED_TEST(Bulldoze, CarriesAPileAtReposeOnEveryHeading) {
   }
   const auto [lo, hi] = std::minmax_element(heights.begin(), heights.end());
   EXPECT_LT(*hi - *lo, 0.15 * *hi) << "the pile depends on the heading";
+}
+
+}  // namespace
+}  // namespace sb
+
+namespace sb {
+namespace {
+
+template <class Backend>
+class Carry : public Bulldoze<Backend> {};
+TYPED_TEST_SUITE(Carry, test::Backends, test::BackendName);
+
+std::string carry_keys(double shed) {
+  return "displacement = \"carry\"\ncarry_shed_fraction = " + std::to_string(shed) + "\n";
+}
+
+TYPED_TEST(Carry, CarriesItsPileAndShedsItsBerms) {
+  const double cut = kLength * 0.03 * kDepth;  // the blade's width times its depth along the stroke
+  const auto keeps_all = this->drag(Vec2(0.08, 0.15), 0.0, carry_keys(0.0));
+  const auto sheds = this->drag(Vec2(0.08, 0.15), 0.0, carry_keys(0.35));
+  const auto turned = this->drag(Vec2(0.22, 0.17), 200.0, carry_keys(0.35));
+  // Shedding nothing, the tool arrives with most of what it cut (erosion spills some beside it:
+  // a pile left where it lies would hold a third, the last stamp's); shedding a third per blade
+  // length, with less (what it sheds ahead of itself, the blade cuts again).
+  EXPECT_GT(keeps_all.pile_volume_m3, 0.65 * cut);
+  EXPECT_LT(sheds.pile_volume_m3, 0.9 * keeps_all.pile_volume_m3);
+  EXPECT_GT(sheds.pile_volume_m3, 0.4 * cut);
+  // What it sheds beside the trench is the berm.
+  EXPECT_GT(sheds.berm_m, keeps_all.berm_m + 0.001);
+  // The pile stands at the repose slope and is the same on another heading.
+  for (const auto* out : {&keeps_all, &sheds, &turned})
+    EXPECT_LE(out->steepest_ahead, std::tan(31.0 * std::numbers::pi / 180.0));
+  EXPECT_NEAR(turned.pile_height_m, sheds.pile_height_m, 0.15 * sheds.pile_height_m);
+  EXPECT_NEAR(turned.pile_volume_m3, sheds.pile_volume_m3, 0.1 * sheds.pile_volume_m3);
 }
 
 }  // namespace

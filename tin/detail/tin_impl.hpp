@@ -15,6 +15,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "common/front_pile.hpp"
 #include "common/height_field.hpp"
 #include "common/scene.hpp"
 #include "common/terrain.hpp"
@@ -295,6 +296,11 @@ class TinTerrain final : public Terrain {
   // false, and nothing changed, when no vertex lies ahead. O(lattice points in the pile's
   // region, each located) per widening of the region; one or two widenings are usual.
   bool deposit_front_pile(StampWork& w, double deposit, StampReport& report);
+  // front_pile.cpp: what a carrying stamp keeps of the pile the stamp before it heaped
+  // (carried_), taken from its vertices outside the footprint that are still there; the volume
+  // taken (written outside any capture). O(that pile's vertices, each located).
+  double pick_up_carried(StampWork& w, const CarriedPileOrigin& origin,
+                         const std::vector<std::pair<Vec2, double>>& base);
   // Vertices on a lattice of refine_m_ (anchored at the domain's corner, so stamps share it)
   // where the pile's region within `reach` of the footprint has none nearby: the pile's slopes
   // resolved as erosion would resolve them, on a mesh that ahead of a tool is often coarse.
@@ -325,6 +331,10 @@ class TinTerrain final : public Terrain {
   // border vertex within `reach` on the same side, if there is one. O(points x vertices near).
   void snap_border_crossings(std::vector<Vec2>& contour, double reach);
   double stale_delta_ = 0.0;  // the current stamp's share of that change
+  // The pile a carrying stamp heaped, for the next one: where its vertices are and their heights
+  // before the deposit (positions, not handles: the next stamp's retriangulation may remove some).
+  CarriedPileOrigin carried_origin_;
+  std::vector<std::pair<Vec2, double>> carried_;
   // erosion.cpp: splits edge (a, b) at its middle (volume change measured, and compensated
   // under tin.conserve_volume); returns the vertex there.
   VertexHandle split_edge(VertexHandle a, VertexHandle b, bool* inserted);
