@@ -3,31 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <utility>
 
 #include "common/tool.hpp"
 
 namespace sb {
-
-namespace {
-// The footprint's extent along the motion, from the pose: [rear, front].
-std::pair<double, double> along_extent(const ToolStamp& s) {
-  double rear = HUGE_VAL, front = -HUGE_VAL;
-  for (const Vec2& v : s.footprint) {
-    const double along = (v - s.pose.xy).dot(s.motion_dir);
-    rear = std::min(rear, along);
-    front = std::max(front, along);
-  }
-  return {rear, front};
-}
-}  // namespace
 
 bool in_front_pile(const ToolStamp& s, const Vec2& p) {
   const Vec2 offset = p - s.pose.xy;
   const double along = offset.dot(s.motion_dir);
   const double across = std::abs(offset.x() * s.motion_dir.y() - offset.y() * s.motion_dir.x());
   // Carrying: beside the tool back to its rear, but not in the trench its rear half sweeps.
-  if (s.carries()) return along > 0.0 || (across > s.half_width_m && along > along_extent(s).first);
+  if (s.carries()) return along > 0.0 || (along > s.rear_m && across > s.half_width_m);
   return along > 0.0 && across <= s.half_width_m;
 }
 
@@ -45,20 +31,20 @@ double pile_distance(const ToolStamp& s, const Vec2& p) {
 }
 
 Aabb2 front_pile_box(const ToolStamp& s, double reach, double margin) {
-  if (s.carries()) return bounds(s.footprint).expanded(reach + margin);
-  // The corridor: the footprint's width across the motion, from the pose to its front plus the reach.
+  // Bulldozing, the corridor: the footprint's width across the motion, from the pose to its
+  // front plus the reach; carrying, the width plus the reach each side, from the tool's rear.
   const Vec2 dir = s.motion_dir, across(-dir.y(), dir.x());
-  double front = 0.0;
-  for (const Vec2& v : s.footprint) front = std::max(front, (v - s.pose.xy).dot(dir));
-  const Vec2 side = s.half_width_m * across, ahead = (front + reach) * dir;
-  const Vec2 a = s.pose.xy + side, b = s.pose.xy - side, c = a + ahead, d = b + ahead;
+  const bool carry = s.carries();
+  const Vec2 side = (s.half_width_m + (carry ? reach : 0.0)) * across;
+  const Vec2 back = (carry ? s.rear_m : 0.0) * dir, ahead = (std::max(0.0, s.front_m) + reach) * dir;
+  const Vec2 a = s.pose.xy + back + side, b = s.pose.xy + back - side, c = s.pose.xy + ahead + side,
+             d = s.pose.xy + ahead - side;
   return Aabb2{a.cwiseMin(b).cwiseMin(c).cwiseMin(d), a.cwiseMax(b).cwiseMax(c).cwiseMax(d)}.expanded(margin);
 }
 
 double carried_fraction(const ToolStamp& s, const CarriedPileOrigin& previous) {
   if (!s.carries() || !previous.valid || s.generation != previous.generation + 1) return 0.0;
-  const auto [rear, front] = along_extent(s);
-  const double length = front - rear, moved = (s.pose.xy - previous.xy).norm();
+  const double length = s.front_m - s.rear_m, moved = (s.pose.xy - previous.xy).norm();
   if (!(length > 0.0) || !(moved <= length)) return 0.0;
   return std::pow(1.0 - s.rim.carry_shed_fraction, moved / length);
 }

@@ -168,6 +168,9 @@ ToolStamp make_stamp(const ToolSpec& spec, const ToolPose& pose, const Vec2& mot
     s.footprint.emplace_back(pose.xy.x() + c * q.x() - sn * q.y(), pose.xy.y() + sn * q.x() + c * q.y());
     const Vec2 offset = s.footprint.back() - pose.xy;
     s.half_width_m = std::max(s.half_width_m, std::abs(offset.x() * motion_dir.y() - offset.y() * motion_dir.x()));
+    const double along = offset.dot(motion_dir);
+    s.rear_m = s.footprint.size() == 1 ? along : std::min(s.rear_m, along);
+    s.front_m = s.footprint.size() == 1 ? along : std::max(s.front_m, along);
   }
   return s;
 }

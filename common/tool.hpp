@@ -88,6 +88,8 @@ struct ToolStamp {
   double sphere_radius_m = 0.0;
   RimRule rim;
   double half_width_m = 0.0;    // the footprint's half extent across the motion, from the pose
+  double rear_m = 0.0;          // the footprint's extent along the motion from the pose: least
+  double front_m = 0.0;         // and greatest (rear_m <= 0 <= front_m for a footprint about it)
   double pour_volume_m3 = 0.0;  // > 0 only for pours
   double pour_radius_m = 0.0;
 
