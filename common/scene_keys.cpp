@@ -47,8 +47,8 @@ std::string scene_key_meaning(const std::string& key) {
       {"tool.rim_width_m", "rim band outside the footprint where displaced sand goes (default: half the radius)"},
       {"tool.rim_forward_bias", "rim weighting towards the motion"},
       {"tool.displacement",
-       "where a moving tool puts the cut sand: bulldozed ahead of it at the angle of repose, carried with it as a pile "
-       "around its front, or on a rim band around it"},
+       "where a moving tool puts the cut sand: carried with it as a pile ahead of and beside it, bulldozed ahead of it "
+       "at the angle of repose, or on a rim band around it"},
       {"tool.carry_shed_fraction",
        "carry: the fraction of its pile the tool leaves behind per its own length travelled"},
       {"tool.volume_m3", "pour: volume poured per stamp"},
