@@ -347,13 +347,15 @@ def run(ctx):
         cases.append(case)
     if not cases:
         return {"cases": [], "table": "", "figures": {}, "displacement": default, "compared": other, "others": others,
-                "tool_force": "", "force_fit": {}, "bars": "", "summary": {}}
+                "tool_force": "", "force_fit": {}, "bars": "", "bars_met": {}, "most_bars": None, "summary": {}}
     md = ctx.table("particles", ["case", "surface", "metric", "particles (mean ± sd over seeds)", *names], rows_csv)
     figures = {"sections": section_figure(ctx, cases, names), "difference": difference_figure(ctx, cases),
                "speed": speed_figure(ctx, cases, names)}
     out = values(cases, md, figures, other, others)
     sessions = {ref.case: model_forces(ctx, ref) for ref in refs if ref.forces}
-    out.update({"displacement": default, "compared": other, "others": others, "bars": bars_table(ctx, cases, names),
+    bars, met = bars_table(ctx, cases, names, default)
+    out.update({"displacement": default, "compared": other, "others": others, "bars": bars, "bars_met": met,
+                "most_bars": max(met, key=lambda m: met[m][0]) if met else None,
                 "tool_force": tool_force_table(ctx, refs, sessions),
                 "force_fit": haptic_calibration.run(ctx, refs, sessions, {ref.case: force_parameters(ctx, scene_of(ref))
                                                                       for ref in refs})})
@@ -371,10 +373,10 @@ BARS = [("trench floor, mm (bar 2)", ("floor_m",), 2e-3, "abs", 1e3),
         ("section RMSE, mm (bar 2)", ("section_rmse_m",), 2e-3, "value", 1e3)]
 
 
-def bars_table(ctx, cases, names):
+def bars_table(ctx, cases, names, default):
     """Each stroke case and model: its distance from the grains' mean on each bar, and whether the
-    bar holds."""
-    rows = []
+    bar holds; and how many bars each model meets over the cases and back-ends, [met, of]."""
+    rows, met = [], {}
     for c in (c for c in cases if c["sections"] is not None):
         dem = {k: float(np.mean([s[k] for s in c["dem_seeds"]])) for _, keys, _, _, _ in BARS for k in keys}
         for label in names:
@@ -388,8 +390,11 @@ def bars_table(ctx, cases, names):
                 else:
                     d = max(abs(m[k] - dem[k]) for k in keys)
                 row.append(f"{d * scale:.2g}{' %' if how == 'rel' else ''} {'yes' if d <= bar else 'no'}")
+                count = met.setdefault(label.split()[1] if " " in label else default, [0, 0])
+                count[0] += d <= bar
+                count[1] += 1
             rows.append(row)
-    return ctx.table("particles_bars", ["case", "model"] + [b[0] for b in BARS], rows) if rows else ""
+    return (ctx.table("particles_bars", ["case", "model"] + [b[0] for b in BARS], rows) if rows else ""), met
 
 
 def values(cases, table, figures, other, others):
@@ -412,7 +417,7 @@ def values(cases, table, figures, other, others):
                                             for o in others},
                          "verdict": ("the shared tool model: the back-ends agree far better with each other "
                                      "than with the grains" if shared else
-                                     "partly the discretisation (back-ends differ by much of it)")})
+                                     "partly the discretisation: back-ends differ by much of it")})
             for b in BACKENDS:  # the report's summary table joins the cases' cells
                 summary.setdefault(b, {}).setdefault("accuracy vs particle sand", [])
                 summary[b]["accuracy vs particle sand"].append(f"{c['case']} {rmse[b] * 1e3:.1f} mm")
