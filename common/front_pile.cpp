@@ -17,18 +17,24 @@ bool in_front_pile(const ToolStamp& s, const Vec2& p) {
   return along > 0.0 && across <= s.half_width_m;
 }
 
-double pile_distance(const ToolStamp& s, const Vec2& p) {
-  if (!s.carries()) return distance_to_boundary(s.footprint, p);
-  double best = HUGE_VAL;
+PileDistance::PileDistance(const ToolStamp& s) {
   const std::size_t n = s.footprint.size();
   for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
     const Vec2 edge = s.footprint[i] - s.footprint[j];
     const Vec2 outward(edge.y(), -edge.x());  // the footprint is counter-clockwise
-    if (outward.dot(s.motion_dir) > 1e-9 * edge.norm())
-      best = std::min(best, squared_distance_to_segment(p, s.footprint[j], s.footprint[i]));
+    if (!s.carries() || outward.dot(s.motion_dir) > 1e-9 * edge.norm())
+      edges_.emplace_back(s.footprint[j], s.footprint[i]);
   }
+}
+
+double PileDistance::operator()(const Vec2& p) const {
+  // One square root for the nearest edge, as distance_to_boundary: the same value bit for bit.
+  double best = HUGE_VAL;
+  for (const auto& [a, b] : edges_) best = std::min(best, squared_distance_to_segment(p, a, b));
   return std::sqrt(best);
 }
+
+double pile_distance(const ToolStamp& s, const Vec2& p) { return PileDistance(s)(p); }
 
 Aabb2 front_pile_box(const ToolStamp& s, double reach, double margin) {
   // Bulldozing, the corridor: the footprint's width across the motion, from the pose to its

@@ -37,6 +37,7 @@
 // heights before the deposit, which each back-end keeps; picking up measures what it takes, so
 // the volume stays exact.
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "common/geometry.hpp"
@@ -58,7 +59,18 @@ struct PileSample {
 bool in_front_pile(const ToolStamp& s, const Vec2& p);
 
 // The distance d of the pile's surface from the tool: to the footprint (bulldozing), or to its
-// edges that face the motion (carrying). O(footprint).
+// edges that face the motion (carrying). The edges are chosen once, when it is made: O(footprint);
+// then O(those edges) a point.
+class PileDistance {
+ public:
+  explicit PileDistance(const ToolStamp& s);
+  double operator()(const Vec2& p) const;
+
+ private:
+  std::vector<std::pair<Vec2, Vec2>> edges_;
+};
+
+// PileDistance for one point. O(footprint).
 double pile_distance(const ToolStamp& s, const Vec2& p);
 
 // The box holding every point of the pile region (in_front_pile) within `reach` of the

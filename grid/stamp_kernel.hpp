@@ -104,6 +104,7 @@ std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, con
   const double tan = s.rim.tan_repose;
   const double margin = 0.5 * std::min(layout.dx, layout.dy);  // rounding at the corridor's edges
   const double outer = std::sqrt(circles.outer2);
+  const PileDistance distance(s);
   double reach = std::max({front_pile_flat_reach(volume, 2.0 * s.half_width_m, tan), s.rim.width_m, layout.diagonal()});
   std::vector<std::uint32_t> nodes;
   std::vector<PileSample> samples;
@@ -121,7 +122,7 @@ std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, con
         const double d2 = (p - circles.centre).squaredNorm();
         if (d2 < circles.inner2 || (d2 <= circles.outer2 && s.contains(p))) continue;
         if (std::sqrt(d2) - outer > reach) continue;  // a lower bound of its distance to the footprint
-        const double d = pile_distance(s, p);
+        const double d = distance(p);
         if (d > reach) continue;
         const std::uint32_t k = layout.index(ix, iy);
         nodes.push_back(k);

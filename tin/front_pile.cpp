@@ -26,6 +26,7 @@ void TinTerrain::fill_pile_lattice(const StampWork& w, double reach, StampReport
   if (!(size.x() >= 0.0 && size.y() >= 0.0)) return;
   const double h = std::max(refine_m_, std::sqrt(size.x() * size.y() / kMaxLatticePoints));
   if (!(h > 0.0)) return;
+  const PileDistance distance(s);
   // Clear of the border (slivers against it) and of the outer contour O (a gap outside the
   // footprint), by half a spacing; clear of other vertices by as much.
   const double clear = 0.5 * h;
@@ -36,7 +37,7 @@ void TinTerrain::fill_pile_lattice(const StampWork& w, double reach, StampReport
     for (long i = first(0); i <= last(0); ++i) {
       const Vec2 p = box_.lo + h * Vec2(static_cast<double>(i), static_cast<double>(j));
       if (!inner.contains(p) || !in_front_pile(s, p) || s.contains(p)) continue;
-      if (distance_to_boundary(s.footprint, p) < w.gap + clear || pile_distance(s, p) > reach) continue;
+      if (distance_to_boundary(s.footprint, p) < w.gap + clear || distance(p) > reach) continue;
       const Location loc = locate(p);
       bool near = false;
       for (int k = 0; k < 3; ++k) {
@@ -55,6 +56,7 @@ bool TinTerrain::deposit_front_pile(StampWork& w, double deposit, StampReport& r
   const ToolStamp& s = w.tool;
   const double tan = s.rim.tan_repose;
   double reach = std::max({front_pile_flat_reach(deposit, 2.0 * s.half_width_m, tan), s.rim.width_m, refine_m_});
+  const PileDistance distance(s);
   std::vector<VertexHandle> found, pile;
   std::vector<PileSample> samples;
   double level = 0.0;
@@ -70,7 +72,7 @@ bool TinTerrain::deposit_front_pile(StampWork& w, double deposit, StampReport& r
     for (VertexHandle v : found) {
       const Vec2 p = xy(v);
       if (!in_front_pile(s, p) || w.in_footprint(p)) continue;
-      const double d = pile_distance(s, p);
+      const double d = distance(p);
       if (d > reach) continue;
       pile.push_back(v);
       samples.push_back({d, v->point().z(), cached_area(v)});
