@@ -55,7 +55,7 @@ struct PileSample {
 // Whether p takes part in a bulldozing stamp's front pile: outside the footprint (the caller
 // knows), ahead of the pose along the motion and within the footprint's half width across it;
 // for a carrying stamp, anywhere ahead of the pose and, beside the footprint's width, back to its
-// rear. O(1) (carrying: O(footprint)).
+// rear. O(1).
 bool in_front_pile(const ToolStamp& s, const Vec2& p);
 
 // The distance d of the pile's surface from the tool: to the footprint (bulldozing), or to its
@@ -86,7 +86,7 @@ struct CarriedPileOrigin {
 
 // What a carrying stamp keeps of the pile `previous` heaped: (1 - shed)^(moved / length) when it
 // follows that stamp (the next generation) and moved at most its own length since, else 0 (a new
-// stroke, or a tool that jumped, starts a new pile). O(footprint).
+// stroke, or a tool that jumped, starts a new pile). O(1).
 double carried_fraction(const ToolStamp& s, const CarriedPileOrigin& previous);
 
 // The origin a carrying stamp leaves for the next one. O(1).

@@ -89,6 +89,12 @@ struct FootprintCircles {
     const double band = outer + std::max(0.0, s.rim.width_m) + margin;
     band2 = band * band;
   }
+
+  // Whether p, at squared distance d2 from the centre, is in the stamp's footprint: the circles
+  // decide, the polygon only between them.
+  bool inside(const ToolStamp& s, const Vec2& p, double d2) const {
+    return d2 < inner2 || (d2 <= outer2 && s.contains(p));
+  }
 };
 
 // The nodes of a bulldozing stamp's front pile (common/front_pile.hpp), each weighted by its
@@ -120,7 +126,7 @@ std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, con
         const Vec2 p = layout.position(ix, iy);
         if (!in_front_pile(s, p)) continue;
         const double d2 = (p - circles.centre).squaredNorm();
-        if (d2 < circles.inner2 || (d2 <= circles.outer2 && s.contains(p))) continue;
+        if (circles.inside(s, p, d2)) continue;
         if (std::sqrt(d2) - outer > reach) continue;  // a lower bound of its distance to the footprint
         const double d = distance(p);
         if (d > reach) continue;
@@ -162,7 +168,7 @@ double pick_up_carried(Store& grid, const ToolStamp& s, const FootprintCircles& 
     const auto [ix, iy] = layout.split(k);
     const Vec2 p = layout.position(ix, iy);
     const double d2 = (p - circles.centre).squaredNorm();
-    if (d2 < circles.inner2 || (d2 <= circles.outer2 && s.contains(p))) continue;
+    if (circles.inside(s, p, d2)) continue;
     const double z = grid.z(k), dz = keep * (z - base);
     if (!(dz > 0.0)) continue;
     grid.set(k, z - dz);
@@ -193,7 +199,7 @@ StampReport cut_and_push(Store& grid, const ToolStamp& s, std::vector<std::uint3
         const double d2 = (p - circles.centre).squaredNorm();
         if (d2 >= circles.band2) continue;
         const std::uint32_t k = layout.index(ix, iy);
-        if (d2 < circles.inner2 || (d2 <= circles.outer2 && s.contains(p))) {
+        if (circles.inside(s, p, d2)) {
           const double bottom = s.bottom_z(p);
           if (cut_pass && grid.z(k) > bottom) cuts.push_back({k, bottom});
         } else if (!cut_pass) {
