@@ -103,9 +103,10 @@ inline void stream_mesh(const SurfaceMesh& m, MeshSink& sink) {
   sink.constrained_edges(m.constrained_edges);
 }
 
-// Display change tracking (Terrain::lattice, changes_since, lattice_heights): a back-end whose
-// surface is a lattice of heights (the grids) tells which nodes changed since a version it gave,
-// so that a display keeping a copy reads only those.
+// Display change tracking (Terrain::lattice, changes_since, lattice_heights, surface_faces): a
+// back-end tells what changed since a version it gave, so that a display keeping a copy reads
+// only that. One whose surface is a lattice of heights (the grids) names node rectangles; a
+// mesh (the TIN) names boxes of its domain, and the display reads the faces in them again.
 
 // Nodes [x0, x1) x [y0, y1) of a lattice.
 struct NodeRect {
@@ -122,8 +123,17 @@ struct HeightLattice {
 struct SurfaceChanges {
   std::uint64_t version = 0;    // ask from this next time
   bool tracked = false;         // false: not tracked, anything may have changed
-  std::vector<NodeRect> rects;  // tracked: every node changed since lies in one (none: nothing changed)
+  std::vector<NodeRect> rects;  // tracked lattice: every node changed since lies in one (none: nothing changed)
+  // Tracked mesh: the centroid (in xy) of every face added or removed since (a face whose
+  // vertices moved counts as both) lies in one of these boxes (none: nothing changed).
+  std::vector<Aabb2> regions;
 };
+
+// Whether the xy centroid of triangle abc lies in [box.lo, box.hi) (surface_faces' rule).
+inline bool centroid_in(const Aabb2& box, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const double x = (a.x() + b.x() + c.x()) / 3.0, y = (a.y() + b.y() + c.y()) / 3.0;
+  return x >= box.lo.x() && x < box.hi.x() && y >= box.lo.y() && y < box.hi.y();
+}
 
 struct IntegrityReport {
   std::vector<std::string> problems;
@@ -157,6 +167,10 @@ class Terrain {
   // Lattice back-ends: the heights of the nodes of `r` minus z_ref, node (x, y) at
   // out[(y - r.y0) * stride + (x - r.x0)]. O(nodes of r).
   virtual void lattice_heights(const NodeRect& /*r*/, double /*z_ref*/, float* /*out*/, std::size_t /*stride*/) const {}
+  // The faces of mesh() whose centroid (in xy) lies in [box.lo, box.hi), three corners each,
+  // appended to `out` (boxes that tile the plane share out every face once). Default: mesh()
+  // filtered, O(n); the TIN: O(faces overlapping the box) after a walk to it.
+  virtual void surface_faces(const Aabb2& box, std::vector<Vec3>& out) const;
 };
 
 }  // namespace sb

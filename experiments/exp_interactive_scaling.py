@@ -34,9 +34,12 @@ FRAMES = 200
 # shorter than haptics_trajectory's defaults, so that 200 frames cover the 3.1 s of motion at the window's 60 Hz
 # pacing.
 MOTION = {"wait_s": 1.5, "hold_s": 0.2, "stroke_s": 1.0}
-# (domain side m, grid cell m) per profile; the TIN runs once per side.
+# (domain side m, grid cell m) per profile; the TIN runs once per side on the flat sand, and on dunes (a TIN
+# grows with what the terrain holds, not with the domain) at each of DUNES_TOLERANCES on the 1 m square.
 DOMAINS = {"tiny": [(1.0, 0.01)],
            "paper": [(1.0, 0.01), (1.0, 0.005), (1.0, 0.002), (1.0, 0.001), (2.0475, 0.0005)]}
+DUNES = ["terrain.kind=dunes", "terrain.wavelength_m=0.1"]
+DUNES_TOLERANCES = {"tiny": [], "paper": [0.0004, 0.0002, 0.0001]}  # tin.tolerance_m
 TINY_BACKENDS = ("grid",)
 # The bars' cases: the 1 m replay at 5 and 1 mm, and the 4096 x 4096 grid.
 COARSE, FINE, LARGE = (1.0, 0.005), (1.0, 0.001), (2.0475, 0.0005)
@@ -50,12 +53,13 @@ COLUMNS = [("fps", "fps", "fps"), ("frame_p50", "frame ms p50", "frame_ms.p50"),
            ("latency_p95", "stamp to frame ms p95", "stamp_to_frame_ms.p95"),
            ("latency_max", "stamp to frame ms max", "stamp_to_frame_ms.max"),
            ("step_p50", "sim step ms p50", "sim.step_ms.p50"), ("step_p95", "sim step ms p95", "sim.step_ms.p95"),
-           ("display_p95", "display ms p95", "display_ms.p95"), ("upload_p95", "upload ms p95", "upload_ms.p95"),
+           ("display_p50", "display ms p50", "display_ms.p50"), ("display_p95", "display ms p95", "display_ms.p95"), ("upload_p95", "upload ms p95", "upload_ms.p95"),
            ("stamps", "stamps", "sim.stamps"), ("steps", "sim steps", "sim.steps")]
 
 
 def cases(profile_name):
-    """(back-end, domain side m, cell m or None for the TIN) in table order."""
+    """(back-end, domain side m, resolution m) in table order: a grid's cell; the TIN's tin.tolerance_m on dunes,
+    or None on the flat sand."""
     domains = DOMAINS.get(profile_name, DOMAINS["paper"])
     backends = TINY_BACKENDS if profile_name == "tiny" else BACKENDS
     out = []
@@ -64,18 +68,27 @@ def cases(profile_name):
             out += [(b, side, cell) for side, cell in domains]
         else:
             out += [(b, side, None) for side in dict.fromkeys(side for side, _ in domains)]
+            out += [(b, 1.0, tol) for tol in DUNES_TOLERANCES.get(profile_name, DUNES_TOLERANCES["paper"])]
     return out
 
 
+def on_dunes(case):
+    return case[0] not in LATTICE_BACKENDS and case[2] is not None
+
+
 def case_name(case):
-    b, side, cell = case
-    return f"{b}-{side:g}m" + (f"-{cell * 1e3:g}mm" if cell is not None else "")
+    b, side, res = case
+    if on_dunes(case):
+        return f"{b}-{side:g}m-dunes-{res * 1e3:g}mm"
+    return f"{b}-{side:g}m" + (f"-{res * 1e3:g}mm" if res is not None else "")
 
 
 def overrides(case):
-    _, side, cell = case
+    _, side, res = case
     sets = [f"domain.size_m=[{side!r}, {side!r}]"]
-    return sets + ([f"grid.cell_m={cell!r}"] if cell is not None else [])
+    if on_dunes(case):
+        return sets + DUNES + [f"tin.tolerance_m={res!r}"]
+    return sets + ([f"grid.cell_m={res!r}"] if res is not None else [])
 
 
 def trajectory_file(folder, side):
@@ -149,9 +162,11 @@ def plot(ctx, rows, renderer):
     fig, axes = plt.subplots(1, 3, figsize=(13, 3.8))
     for ax, (key, label, lines) in zip(axes, panels):
         for b in BACKENDS:
-            pts = sorted((r["elements"], r[key]) for c, r in rows.items() if c[0] == b and r[key] > 0)
-            if pts:
-                ax.plot(*zip(*pts), "o-", label=b)
+            for dunes in (False, True):
+                pts = sorted((r["elements"], r[key]) for c, r in rows.items()
+                             if c[0] == b and on_dunes(c) == dunes and r[key] > 0)
+                if pts:
+                    ax.plot(*zip(*pts), "s--" if dunes else "o-", label=b + (" (dunes)" if dunes else ""))
         for y, text in lines:
             ax.axhline(y, color="0.6", ls="--", lw=0.8)
             ax.annotate(text, (0.02, y), xycoords=("axes fraction", "data"), fontsize=7, color="0.4", va="bottom")
@@ -226,9 +241,9 @@ def run(ctx):
 
 
 def order(case):
-    """Table order: back-end, then domain, coarse cells first."""
-    b, side, cell = case
-    return BACKENDS.index(b), side, -(cell or 0.0)
+    """Table order: back-end, flat before dunes, then domain, coarse cells (tolerances) first."""
+    b, side, res = case
+    return BACKENDS.index(b), on_dunes(case), side, -(res or 0.0)
 
 
 def values(ctx, rows, renderer, costs=None):
@@ -236,24 +251,28 @@ def values(ctx, rows, renderer, costs=None):
     bars, summary cells."""
     todo = sorted(rows, key=order)
     png = plot(ctx, rows, renderer)
-    table_rows = [[b, side, cell * 1e3 if cell is not None else "", rows[(b, side, cell)]["elements"]] +
-                  [rows[(b, side, cell)][key] for key, _, _ in COLUMNS] for b, side, cell in todo]
-    md = ctx.table("interactive_scaling", ["back-end", "domain m", "cell mm", "elements"] +
+    table_rows = [[b, "dunes" if on_dunes((b, side, res)) else "flat", side, res * 1e3 if res is not None else "",
+                   rows[(b, side, res)]["elements"]] +
+                  [rows[(b, side, res)][key] for key, _, _ in COLUMNS] for b, side, res in todo]
+    md = ctx.table("interactive_scaling", ["back-end", "terrain", "domain m", "cell (TIN: tolerance) mm", "elements"] +
                    [header for _, header, _ in COLUMNS], table_rows)
     bars = judge(rows)
     summary = {}
     for b in BACKENDS:  # the finest 1 m case of each back-end
-        one_m = [c for c in todo if c[0] == b and c[1] == 1.0]
+        one_m = [c for c in todo if c[0] == b and c[1] == 1.0 and not on_dunes(c)]
         if one_m:
             r = rows[one_m[-1]]
             summary[b] = {"interactive frame rate": f"{r['fps']:.0f} fps at {r['elements']:.2g} "
                           f"{'vertices' if b == 'tin' else 'nodes'}, {WINDOW[0]}x{WINDOW[1]}"}
     # How many median frames a stamp waits to be shown (p95), over the runs that stamped.
     lags = [r["latency_p95"] / r["frame_p50"] for r in rows.values() if r["stamps"] > 0 and r["frame_p50"] > 0]
-    tin = [rows[c] for c in todo if c[0] == "tin" and c[1] == 1.0]
+    tin = [rows[c] for c in todo if c[0] == "tin" and c[1] == 1.0 and not on_dunes(c)]
+    dunes = [rows[c] for c in todo if on_dunes(c)]
     return {"skipped": "", "png": png, "table": md, "renderer": renderer, "window": f"{WINDOW[0]} x {WINDOW[1]}",
             "lag_lo": min(lags, default=float("nan")), "lag_hi": max(lags, default=float("nan")),
             "tin_fps": tin[0]["fps"] if tin else float("nan"),
+            "dunes": [{"elements": r["elements"], "fps": r["fps"], "latency_p95": r["latency_p95"],
+                       "display_p50": r["display_p50"]} for r in dunes],
             "frames": FRAMES, "bars": bars, "bars_table": bars_table(bars) if bars else "",
             "met": sum(b["met"] for b in bars), "rows": {case_name(c): r for c, r in rows.items()},
             "costs": costs or {}, "summary": summary}

@@ -118,6 +118,7 @@ void TinTerrain::finish_build() {
     hull_vertices_ += v->info().border;
   }
   edit_walk_.hint = query_walk_.hint = cdt_.finite_vertices_begin();
+  changes_.mark_all();
 }
 
 namespace {

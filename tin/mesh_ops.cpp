@@ -234,6 +234,7 @@ VertexHandle TinTerrain::insert_point(const Vec2& p_in, double z, bool* inserted
   hull_vertices_ += v->info().border;
   // Every face the insertion (and its flips) changed is incident to v now.
   forget_star(v);
+  mark_star(v);
   if (splits_constraint) {
     generations_[EdgeKey(e1, v)] = generation;
     generations_[EdgeKey(v, e2)] = generation;
@@ -266,6 +267,12 @@ void TinTerrain::remove_vertex(VertexHandle v) {
     else
       link_scratch_.push_back(c);
   } while (++c != done);
+  // The hole is filled inside the link (and, on the hull, its border edge).
+  if (changes_.tracking()) {
+    Aabb2 hole{xy(v), xy(v)};
+    for (VertexHandle w : link_scratch_) hole = united(hole, Aabb2{xy(w), xy(w)});
+    mark_changed(hole);
+  }
   if (on_hull)
     cdt_.remove(v);
   else
@@ -328,6 +335,11 @@ void TinTerrain::remove_by_flips(VertexHandle v) {
     if (!cdt_.is_edge(a, b, f, i) || !cdt_.is_flipable(f, i)) continue;
     const VertexHandle c = f->vertex(i), d = f->neighbor(i)->vertex(cdt_.mirror_index(f, i));
     cdt_.flip(f, i);
+    if (changes_.tracking()) {
+      Aabb2 quad{xy(a), xy(a)};
+      for (VertexHandle w : {b, c, d}) quad = united(quad, Aabb2{xy(w), xy(w)});
+      mark_changed(quad);
+    }
     diagonals.insert(diagonals.end(), {{a, c}, {c, b}, {b, d}, {d, a}});
   }
 }
@@ -421,6 +433,31 @@ bool TinTerrain::has_long_edges(VertexHandle v) const {
 void TinTerrain::set_z(VertexHandle v, double z) {
   const Point& p = v->point();
   v->set_point(Point(p.x(), p.y(), z));
+  if (changes_.tracking() && !v->info().display_pending) {
+    v->info().display_pending = 1;
+    display_pending_.push_back(v);
+  }
+}
+
+void TinTerrain::mark_pending_stars() {
+  // A listed vertex since removed: its hole was marked then (remove_vertex); its slot, if
+  // reused, holds a new vertex whose star insert_point marked.
+  for (const VertexHandle v : display_pending_) {
+    if (!cdt_.tds().vertices().is_used(v) || !v->info().display_pending) continue;
+    v->info().display_pending = 0;
+    mark_star(v);
+  }
+  display_pending_.clear();
+}
+
+void TinTerrain::mark_star(VertexHandle v) {
+  if (!changes_.tracking()) return;
+  Aabb2 star{xy(v), xy(v)};
+  auto c = cdt_.incident_vertices(v), done = c;
+  do {
+    if (!cdt_.is_infinite(c)) star = united(star, Aabb2{xy(c), xy(c)});
+  } while (++c != done);
+  mark_changed(star);
 }
 
 namespace {
@@ -524,6 +561,14 @@ CaptureResult TinTerrain::end_capture(Capture& c, std::vector<VertexHandle>* reg
     }
   }
   r.faces_after = face_scratch_.size();
+  // What the edits in between changed lies in the region (constraints' flips included).
+  if (changes_.tracking()) {
+    if (!intact) changes_.mark_all();
+    Aabb2 region{xy(start->vertex(0)), xy(start->vertex(0))};
+    for (const FaceHandle f : face_scratch_)
+      for (int i = 0; i < 3; ++i) region = united(region, Aabb2{xy(f->vertex(i)), xy(f->vertex(i))});
+    mark_changed(region);
+  }
   if (!intact || std::abs(r.area_after - r.area_before) > 1e-9 * std::max(r.area_before, 1e-30)) {
     ++capture_mismatches_;
     r.volume_after = r.volume_before;  // unknown: report no change rather than a wrong one
@@ -643,7 +688,7 @@ void TinTerrain::drop_from_simplify(VertexHandle v) {
   v->info().simplify_slot = kNoSlot;
 }
 
-std::uint32_t TinTerrain::next_face_epoch() {
+std::uint32_t TinTerrain::next_face_epoch() const {
   if (face_epoch_ >= 0xFFFFFF00u) {
     for (auto f = cdt_.all_faces_begin(); f != cdt_.all_faces_end(); ++f) f->info() = 0;
     face_epoch_ = 0;

@@ -149,6 +149,7 @@ void TinTerrain::project_heights(const HeightField& field) {
   }
   for (std::size_t i = 0; i < n; ++i)
     vertices[i]->set_point(Point(vertices[i]->point().x(), vertices[i]->point().y(), z[i]));
+  changes_.mark_all();
 }
 
 }  // namespace sb::tin::detail

@@ -65,7 +65,7 @@ ModelStats TinTerrain::stats() const {
            vector_bytes(link_scratch_) + vector_bytes(work_scratch_) + vector_bytes(redundant_scratch_) +
            vector_bytes(link_hold_scratch_) + vector_bytes(ring_pool_) + vector_bytes(ring_scratch_) +
            vector_bytes(diagonal_scratch_) + vector_bytes(link_z_scratch_) + vector_bytes(link_area_scratch_) +
-           vector_bytes(carried_);
+           vector_bytes(carried_) + changes_.bytes() + vector_bytes(display_pending_);
   st.bytes = bytes;
   return st;
 }

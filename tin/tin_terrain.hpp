@@ -47,6 +47,11 @@
 //                     10^3 to 10^6, on tin.initial_points TINs with their border points too,
 //                     log-log slope -0.006 (tests/bench/tin_step_bench.cpp; 0.73 ms on the
 //                     heightmap scene's TIN), where the paper measured O(n^1.5)
+//   display tracking (off until changes_since is first called): each edit marks the cells of a
+//                     64 x 64 division of the domain under the faces it changed, O(its star or
+//                     region); a height write lists its vertex, O(1); changes_since marks the
+//                     listed vertices' stars, O(listed x degree), and reports O(4096 cells);
+//                     surface_faces(box): O(faces overlapping the box) after a walk to it
 //   volume, mesh, check, max_slope_deg: O(n); sample: O(faces + raster points), rasterising the
 //                     faces (~225 instructions a point), or a short walk per point (~1000) where
 //                     the raster has fewer than a quarter as many points as the TIN has faces

@@ -44,8 +44,11 @@ void add_interactive_command(CLI::App& app) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--mesh-display", o->mesh_display,
-                "Draw a grid as one mesh rebuilt and uploaded whole whenever it changes (the TIN's way), "
+                "Draw the terrain as one mesh rebuilt and uploaded whole whenever it changes, "
                 "not from its changed tiles: for comparison");
+  cmd->add_flag("!--no-panel", o->panel,
+                "Draw the terrain and the tool without the control panel (screenshots for figures; its "
+                "controls keep the scene's values)");
   cmd->add_flag("!--no-realtime", o->realtime, "Do not ask for real-time (SCHED_FIFO) priority for the servo thread");
   auto size = std::make_shared<std::vector<int>>();
   cmd->add_option("--size", *size, "Window size: --size 1280 800")->expected(2)->check(CLI::Range(64, 8192));

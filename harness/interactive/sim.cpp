@@ -14,7 +14,7 @@ namespace {
 
 constexpr double kMinPenetration_m = 1e-4;       // shallower contact does not stamp
 constexpr double kDisplayPeriod_s = 1.0 / 30.0;  // counters, and a whole mesh
-constexpr double kTilePeriod_s = 1.0 / 60.0;     // a lattice's changed tiles
+constexpr double kTilePeriod_s = 1.0 / 60.0;     // changed tiles (a lattice's or a mesh's)
 constexpr std::size_t kRecentSteps = 256;
 
 double patch_margin(double reach_m) { return std::max(0.015, 0.5 * reach_m); }
@@ -49,7 +49,7 @@ Simulation::Simulation(const PreparedScene& prepared, std::unique_ptr<Terrain> t
   status_.volume_initial_m3 = totals_.volume_initial_m3;
   volume_m3_ = totals_.volume_initial_m3;
   const Aabb2 box = prepared.scene.domain.box();
-  feed_ = std::make_unique<DisplayFeed>(*terrain_, prepared.initial(0.5 * (box.lo + box.hi)), tiles);
+  feed_ = std::make_unique<DisplayFeed>(*terrain_, prepared.initial(0.5 * (box.lo + box.hi)), box, tiles);
   publish_patch(prepared.scene.domain.box().lo + 0.5 * prepared.scene.domain.size_m);
   publish_display(true);
 }
@@ -255,10 +255,11 @@ void Simulation::add_volume(double change_m3) {
 
 void Simulation::publish_display(bool force) {
   const double now = clock_.seconds();
-  const double period = feed_->lattice() ? kTilePeriod_s : kDisplayPeriod_s;
-  // A lattice's changed tiles cost what changed, so a stamp is published at once: waiting for
-  // the period would add up to a period to its latency. A mesh is rebuilt whole, at most once a period.
-  const bool stamp_waiting = feed_->lattice() && !stamp_times_s_.empty();
+  const bool by_tiles = feed_->lattice() || feed_->mesh_tiles() > 0;
+  const double period = by_tiles ? kTilePeriod_s : kDisplayPeriod_s;
+  // Changed tiles cost what changed, so a stamp is published at once: waiting for the period
+  // would add up to a period to its latency. A mesh is rebuilt whole, at most once a period.
+  const bool stamp_waiting = by_tiles && !stamp_times_s_.empty();
   if (force || (dirty_ && (stamp_waiting || now - last_surface_s_ >= period))) {
     Stopwatch sw;
     if (feed_->publish(*terrain_, dirty_ || force, stamp_times_s_)) totals_.display_ms.push_back(1e3 * sw.seconds());

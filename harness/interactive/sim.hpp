@@ -3,8 +3,8 @@
 // read the servo's newest state; stamp when the tool penetrates the sand and has moved at
 // least the stroke spacing (or gone deeper) since the last stamp; erode within a per-step
 // budget; simplify; republish the height patch for the servo; hand what changed of the surface
-// to the window's DisplayFeed (display_feed.hpp: the changed tiles of a grid up to 60 times a
-// second, a whole mesh of a TIN up to 30) and every 1/30 s the counters. Nothing per display
+// to the window's DisplayFeed (display_feed.hpp: the changed tiles of a grid or of the TIN's
+// domain up to 60 times a second, a whole mesh up to 30) and every 1/30 s the counters. Nothing per display
 // update costs the size of the terrain: the volume shown is kept from the phases' reported
 // changes, as the runner does. Controls from the window and the counters go through a mutex
 // that the servo never sees. Optionally records the session (device samples drained from the
@@ -62,7 +62,7 @@ class Simulation {
  public:
   // Publishes a first patch (at the domain's centre) and the whole surface before returning, so
   // the servo and the window have something from their first tick and frame.
-  // tiles: a lattice back-end's display is fed by its changed tiles (false: by whole meshes).
+  // tiles: the display is fed by changed tiles, a lattice's or the domain's (false: by whole meshes).
   Simulation(const PreparedScene& prepared, std::unique_ptr<Terrain> terrain, haptics::PatchBuffer& patches,
              haptics::ServoLoop& servo, std::string backend, bool tiles = true);
   ~Simulation();

@@ -224,6 +224,7 @@ class WindowLoop {
     view_ = std::make_unique<TerrainView>(Vec3(centre.x(), centre.y(), z0), setup.limits.workspace.lo.z() + 0.1 - 0.02,
                                           setup.limits.workspace.hi.z() - 0.1);
     if (const auto& lattice = sim.display().lattice()) view_->use_lattice(*lattice, sim.display().z_ref());
+    if (const std::size_t tiles = sim.display().mesh_tiles()) view_->use_mesh_tiles(tiles, sim.display().origin());
     camera_.target = Vec3(centre.x(), centre.y(), z0);
     camera_.distance_m = std::clamp(0.6 * (box.hi - box.lo).norm(), 0.1, 50.0);
     mouse_device_ = dynamic_cast<haptics::SharedPoseDevice*>(setup.device.get());
@@ -289,11 +290,11 @@ class WindowLoop {
       const Vec3 goal(shown_.device.position_m.x(), shown_.device.position_m.y(), shown_.model.surface_z_m);
       camera_.target += std::min(1.0, 4.0 * dt) * (goal - camera_.target);
     }
-    show_panel(status);
+    if (o_.panel) show_panel(status);
     const Vec2 focus = shown_.device.valid ? Vec2(shown_.device.position_m.head<2>()) : Vec2(camera_.target.head<2>());
     view_->draw(camera_, fb_w, fb_h, panel_.wireframe, tool_overlay(controls_.tool, status.tool_heading_rad, shown_),
                 focus);
-    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    if (o_.panel) ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     if (last && !o_.screenshot.empty()) {
       screenshot_ = view_->read_pixels(fb_w, fb_h);
       shot_w_ = fb_w;
@@ -341,12 +342,17 @@ class WindowLoop {
     }
   }
 
-  // The feed's changed tiles (a lattice) or its newest mesh, uploaded; the stamps they show.
+  // The feed's changed tiles (a lattice's or a mesh's) or its newest mesh, uploaded; the stamps they show.
   void take_surface() {
     DisplayFeed& feed = sim_.display();
     Stopwatch sw;
     bool uploaded = false;
-    if (feed.take(update_)) {
+    const std::vector<double>* stamp_times_s = &update_.stamp_times_s;
+    if (feed.mesh_tiles() > 0) {
+      uploaded = feed.take(mesh_update_);
+      if (uploaded) view_->upload_mesh_tiles(mesh_update_);
+      stamp_times_s = &mesh_update_.stamp_times_s;
+    } else if (feed.take(update_)) {
       view_->upload_lattice(update_);
       uploaded = true;
     } else if (auto m = feed.mesh(); !feed.lattice() && m && m->version != mesh_version_) {
@@ -355,7 +361,7 @@ class WindowLoop {
       uploaded = true;
     }
     if (uploaded) upload_ms_.push_back(1e3 * sw.seconds());
-    unshown_stamps_s_.insert(unshown_stamps_s_.end(), update_.stamp_times_s.begin(), update_.stamp_times_s.end());
+    unshown_stamps_s_.insert(unshown_stamps_s_.end(), stamp_times_s->begin(), stamp_times_s->end());
   }
 
   void show_panel(const SimStatus& status) {
@@ -399,6 +405,7 @@ class WindowLoop {
   SimControls controls_;
   haptics::ServoState shown_;
   LatticeUpdate update_;
+  MeshTileUpdate mesh_update_;
   std::uint64_t mesh_version_ = ~0ull;
   long frames_ = 0;
   double wall_s_ = 0.0;

@@ -23,7 +23,8 @@ struct InteractiveOptions {
   double rate_hz = 1000.0;
   double spin_us = 150.0;
   bool realtime = true;
-  bool mesh_display = false;  // grids drawn as a whole mesh, as the TIN (for comparison)
+  bool mesh_display = false;  // the terrain drawn as a whole mesh, not by changed tiles (for comparison)
+  bool panel = true;          // false: the terrain and the tool alone (screenshots for figures, tests)
   int width = 1280, height = 800;
 };
 

@@ -62,6 +62,7 @@ TerrainView::TerrainView(const Vec3& origin, double z_lo, double z_hi) : origin_
 
 TerrainView::~TerrainView() {
   lattice_.reset();
+  mesh_tiles_.reset();
   glDeleteBuffers(1, &mesh_vbo_);
   glDeleteBuffers(1, &mesh_ebo_);
   glDeleteBuffers(1, &line_vbo_);
@@ -95,6 +96,14 @@ void TerrainView::upload_lattice(const LatticeUpdate& update) {
   if (lattice_) lattice_->upload(update);
 }
 
+void TerrainView::use_mesh_tiles(std::size_t tiles, const Vec3& feed_origin) {
+  mesh_tiles_ = std::make_unique<MeshTileSurface>(tiles, feed_origin - origin_);
+}
+
+void TerrainView::upload_mesh_tiles(const MeshTileUpdate& update) {
+  if (mesh_tiles_) mesh_tiles_->upload(update);
+}
+
 void TerrainView::draw(const Camera& camera, int width, int height, bool wireframe,
                        const std::vector<LineVertex>& lines, const Vec2& focus) {
   glViewport(0, 0, width, height);
@@ -118,6 +127,8 @@ void TerrainView::draw(const Camera& camera, int width, int height, bool wirefra
   const auto surface = [&] {
     if (lattice_) {
       lattice_->draw(focus);
+    } else if (mesh_tiles_) {
+      mesh_tiles_->draw();
     } else {
       glBindVertexArray(mesh_vao_);
       glDrawElements(GL_TRIANGLES, mesh_indices_, GL_UNSIGNED_INT, nullptr);

@@ -1,9 +1,10 @@
 #pragma once
 // The interactive window's 3-D drawing, plain OpenGL 3.3 core through libepoxy: the terrain
 // (flat-shaded facets, coloured by height, optional wireframe) and coloured line overlays (the
-// tool, the force arrow). The terrain is a mesh (uploading one is O(vertices + triangles)) or,
-// for a height lattice, a LatticeSurface (lattice_view.hpp: uploads per changed tile, triangles
-// bounded by its levels of detail around the tool); both share one fragment shader.
+// tool, the force arrow). The terrain is a mesh (uploading one is O(vertices + triangles)), a
+// mesh by tiles (mesh_tiles_view.hpp: uploads per changed tile) or, for a height lattice, a
+// LatticeSurface (lattice_view.hpp: uploads per changed tile, triangles bounded by its levels of
+// detail around the tool); all share one fragment shader.
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "common/terrain.hpp"
 #include "harness/render/camera.hpp"
 #include "harness/window/lattice_view.hpp"
+#include "harness/window/mesh_tiles_view.hpp"
 
 namespace sb {
 
@@ -31,6 +33,10 @@ class TerrainView {
   // From now on the terrain is this lattice, drawn from its heights (DisplayFeed's z_ref).
   void use_lattice(const HeightLattice& lattice, double z_ref);
   void upload_lattice(const LatticeUpdate& update);
+  // From now on the terrain is a mesh by tiles (DisplayFeed::mesh_tiles, positions relative to
+  // the feed's origin).
+  void use_mesh_tiles(std::size_t tiles, const Vec3& feed_origin);
+  void upload_mesh_tiles(const MeshTileUpdate& update);
   // Clears and draws the terrain and the lines for a width x height framebuffer; a lattice is
   // drawn at full resolution around `focus` (world x, y: the tool).
   void draw(const Camera& camera, int width, int height, bool wireframe, const std::vector<LineVertex>& lines,
@@ -46,6 +52,7 @@ class TerrainView {
   unsigned line_vao_ = 0, line_vbo_ = 0;
   int mesh_indices_ = 0;
   std::unique_ptr<LatticeSurface> lattice_;
+  std::unique_ptr<MeshTileSurface> mesh_tiles_;
 };
 
 }  // namespace sb

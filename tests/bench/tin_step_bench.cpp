@@ -73,6 +73,8 @@ struct Setup {
   sb::Vec2 centre;
   sb::ErosionRule rule;
   bool from_scene = false;  // built by make_tin_terrain: stamp depths from the TIN itself
+  bool displayed = false;   // a display tracks the changes: changes_since after every step
+  std::uint64_t version = 0;
 };
 
 std::unique_ptr<Setup> build(std::int64_t n, bool conserve, bool border) {
@@ -116,7 +118,7 @@ sb::ToolStamp pose(const Setup& s, int k) {
 }
 
 struct PhaseTimes {
-  double stamp_s = 0.0, erode_s = 0.0, simplify_s = 0.0;
+  double stamp_s = 0.0, erode_s = 0.0, simplify_s = 0.0, changes_s = 0.0;
   std::size_t updates = 0;
 };
 
@@ -127,10 +129,13 @@ void step(Setup& s, int k, PhaseTimes* times = nullptr) {
   const sb::ErosionReport r = s.terrain->erode(s.rule, sb::ErosionBudget{s.scene.erosion.max_passes_per_step});
   const double t2 = watch.seconds();
   s.terrain->simplify(sb::SimplifyParams{s.scene.tin.alpha_flat_deg});
+  const double t3 = watch.seconds();
+  if (s.displayed) s.version = s.terrain->changes_since(s.version).version;
   if (times) {
     times->stamp_s += t1;
     times->erode_s += t2 - t1;
-    times->simplify_s += watch.seconds() - t2;
+    times->simplify_s += t3 - t2;
+    times->changes_s += watch.seconds() - t3;
     times->updates += r.updates;
   }
 }
@@ -176,6 +181,7 @@ void run_steps(benchmark::State& state, Setup& s) {
   state.counters["stamp_us"] = 1e6 * times.stamp_s / k;
   state.counters["erode_us"] = 1e6 * times.erode_s / k;
   state.counters["simplify_us"] = 1e6 * times.simplify_s / k;
+  state.counters["changes_us"] = 1e6 * times.changes_s / k;
   state.counters["erosion_updates"] = static_cast<double>(times.updates) / k;
   state.counters["vertices"] = static_cast<double>(after.vertices);
   state.counters["walk_steps_per_step"] =
@@ -200,6 +206,22 @@ Setup& scene_setup(std::int64_t n) {
 }
 
 void BM_TinStepInitialPoints(benchmark::State& state) { run_steps(state, scene_setup(state.range(0))); }
+
+// The heightmap's steps without and with a display tracking what changed (TinTerrain::changes_since after every
+// step, more often than a window asks): what the tracking's marks and its answers cost. Separate TINs, built and
+// warmed up alike.
+void BM_TinStepDisplayed(benchmark::State& state) {
+  static std::map<bool, std::unique_ptr<Setup>> cache;
+  const bool displayed = state.range(0) != 0;
+  auto& slot = cache[displayed];
+  if (!slot) {
+    slot = build_from_scene(0);
+    slot->displayed = displayed;
+    if (displayed) slot->version = slot->terrain->changes_since(0).version;
+    for (int k = 0; k < 2 * kPoses; ++k) step(*slot, k);
+  }
+  run_steps(state, *slot);
+}
 void BM_TinStepHeightmap(benchmark::State& state) { run_steps(state, scene_setup(0)); }
 
 BENCHMARK(BM_TinStep)
@@ -225,6 +247,13 @@ BENCHMARK(BM_TinStepInitialPoints)
     ->Iterations(240)
     ->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_TinStepHeightmap)->Iterations(240)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TinStepDisplayed)
+    ->ArgName("display")
+    ->Arg(0)
+    ->Arg(1)
+    ->Iterations(480)
+    ->Repetitions(5)
+    ->Unit(benchmark::kMicrosecond);
 
 // Collects the median (or the only) CPU time (the machine may be shared) per (conserve, border) series and N, and
 // prints the least-squares slope of log(time) against log(N).

@@ -68,7 +68,7 @@ class InteractiveScaling(unittest.TestCase):
         return {"fps": fps, "frame_ms.p50": 1e3 / fps, "frame_ms.p99": 2e3 / fps, "stamp_to_frame_ms.p50": 0.5 *
                 latency_p95, "stamp_to_frame_ms.p95": latency_p95, "stamp_to_frame_ms.max": 1.2 * latency_p95,
                 "sim.step_ms.p50": 0.1, "sim.step_ms.p95": step_p95,
-                "display_ms.p95": 0.1, "upload_ms.p95": 0.2, "sim.stamps": stamps, "sim.steps": 400, "cells": cells,
+                "display_ms.p50": 0.05, "display_ms.p95": 0.1, "upload_ms.p95": 0.2, "sim.stamps": stamps, "sim.steps": 400, "cells": cells,
                 "vertices": vertices}
 
     def test_cases_span_the_sizes_and_tiny_runs_one(self):
@@ -78,8 +78,13 @@ class InteractiveScaling(unittest.TestCase):
         self.assertIn(("grid",) + x.FINE, paper)
         self.assertIn(("sparse",) + x.COARSE, paper)
         self.assertIn(("grid",) + x.LARGE, paper)
-        self.assertEqual([c for c in paper if c[0] == "tin"], [("tin", 1.0, None), ("tin", 2.0475, None)])
+        self.assertEqual([c for c in paper if c[0] == "tin"],
+                         [("tin", 1.0, None), ("tin", 2.0475, None), ("tin", 1.0, 0.0004), ("tin", 1.0, 0.0002),
+                          ("tin", 1.0, 0.0001)])
         self.assertEqual(x.overrides(("grid", 1.0, 0.001)), ["domain.size_m=[1.0, 1.0]", "grid.cell_m=0.001"])
+        self.assertEqual(x.overrides(("tin", 1.0, 0.0002)), ["domain.size_m=[1.0, 1.0]", "terrain.kind=dunes",
+                                                               "terrain.wavelength_m=0.1", "tin.tolerance_m=0.0002"])
+        self.assertEqual(x.case_name(("tin", 1.0, 0.0002)), "tin-1m-dunes-0.2mm")
 
     def test_bars_table_and_section(self):
         import csv
@@ -89,7 +94,8 @@ class InteractiveScaling(unittest.TestCase):
         import sbrun
         made = {("grid", 1.0, 0.005): self.stats(20.0, 0.1, 40.0), ("grid", 1.0, 0.001): self.stats(20.0, 0.2, 60.0),
                 ("grid", 2.0475, 0.0005): self.stats(14.0, 3.0, 90.0, cells=4096 ** 2),
-                ("tin", 1.0, None): self.stats(50.0, 1.0, 30.0, cells=0, vertices=900, stamps=0)}
+                ("tin", 1.0, None): self.stats(50.0, 1.0, 30.0, cells=0, vertices=900, stamps=0),
+                ("tin", 1.0, 0.0002): self.stats(45.0, 1.0, 40.0, cells=0, vertices=23000)}
         rows = {c: x.figures(c, s) for c, s in made.items()}
         self.assertEqual(rows[("tin", 1.0, None)]["elements"], 900)
         self.assertNotEqual(rows[("tin", 1.0, None)]["latency_p95"], rows[("tin", 1.0, None)]["latency_p95"],
@@ -111,7 +117,8 @@ class InteractiveScaling(unittest.TestCase):
             values = x.values(ctx, rows, "llvmpipe")
             with open(Path(tmp) / "interactive_scaling.csv") as f:
                 table = list(csv.DictReader(f))
-            self.assertEqual([r["back-end"] for r in table], ["grid", "grid", "grid", "tin"])
+            self.assertEqual([(r["back-end"], r["terrain"]) for r in table],
+                             [("grid", "flat")] * 3 + [("tin", "flat"), ("tin", "dunes")])
             self.assertEqual(float(table[1]["fps"]), 20.0)
             self.assertEqual(int(table[2]["elements"]), 4096 ** 2)
             self.assertTrue((Path(tmp) / values["png"]).stat().st_size > 0)
@@ -119,6 +126,7 @@ class InteractiveScaling(unittest.TestCase):
         self.assertIn("**Verdict.**", text)
         self.assertIn("**Method or code:**", text)
         self.assertIn("llvmpipe", text)
+        self.assertIn("on dunes 45 at\n23000 vertices", text)
         self.assertIn("Skipped: no display", report.render("interactive_scaling", {"skipped": "no display"}))
 
 

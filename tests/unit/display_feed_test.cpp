@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <random>
 #include <thread>
@@ -24,14 +26,29 @@
 namespace sb {
 namespace {
 
-// A window's copy of a lattice, brought up to date by what it takes.
+// A window's copy, brought up to date by what it takes: a lattice's heights, or a mesh's faces
+// by tile.
 struct WindowCopy {
   std::vector<float> z;
+  std::vector<std::vector<float>> tiles;
   std::vector<double> stamp_times_s;
-  void take(DisplayFeed& feed, std::size_t nx) {
+  void take(DisplayFeed& feed) {
+    if (feed.mesh_tiles() > 0) {
+      MeshTileUpdate u;
+      feed.take(u);
+      stamp_times_s.insert(stamp_times_s.end(), u.stamp_times_s.begin(), u.stamp_times_s.end());
+      tiles.resize(feed.mesh_tiles());
+      ASSERT_EQ(u.offsets.size(), u.tiles.size() + 1);
+      for (std::size_t k = 0; k < u.tiles.size(); ++k)
+        tiles[u.tiles[k]].assign(u.xyz.begin() + static_cast<std::ptrdiff_t>(u.offsets[k]),
+                                 u.xyz.begin() + static_cast<std::ptrdiff_t>(u.offsets[k + 1]));
+      return;
+    }
     LatticeUpdate u;
     feed.take(u);
     stamp_times_s.insert(stamp_times_s.end(), u.stamp_times_s.begin(), u.stamp_times_s.end());
+    if (!feed.lattice()) return;
+    const std::size_t nx = feed.lattice()->nx;
     std::size_t offset = 0;
     for (const NodeRect& r : u.rects)
       for (std::size_t y = r.y0; y < r.y1; ++y)
@@ -53,6 +70,52 @@ void expect_same_mesh(const SurfaceMesh& a, const SurfaceMesh& b, const std::str
   EXPECT_EQ(a.triangles, b.triangles) << who;
 }
 
+using Face = std::array<float, 9>;
+
+// The faces of the window's tiles, sorted.
+std::vector<Face> tile_faces(const WindowCopy& w) {
+  std::vector<Face> faces;
+  for (const std::vector<float>& t : w.tiles) {
+    EXPECT_EQ(t.size() % 9, 0u);
+    for (std::size_t i = 0; i + 9 <= t.size(); i += 9) {
+      Face f;
+      std::copy_n(t.begin() + static_cast<std::ptrdiff_t>(i), 9, f.begin());
+      faces.push_back(f);
+    }
+  }
+  std::sort(faces.begin(), faces.end());
+  return faces;
+}
+
+// The faces of a whole mesh as the feed sends them (float corners relative to `origin`), sorted.
+std::vector<Face> mesh_faces(const SurfaceMesh& m, const Vec3& origin) {
+  std::vector<Face> faces;
+  for (const auto& t : m.triangles) {
+    Face f;
+    for (int c = 0; c < 3; ++c) {
+      const Vec3 q = m.vertices[t[static_cast<std::size_t>(c)]] - origin;
+      for (int a = 0; a < 3; ++a) f[static_cast<std::size_t>(3 * c + a)] = static_cast<float>(q[a]);
+    }
+    faces.push_back(f);
+  }
+  std::sort(faces.begin(), faces.end());
+  return faces;
+}
+
+// The window's copy equals a full read of the terrain.
+void expect_copy_of(const WindowCopy& w, DisplayFeed& feed, const Terrain& t, const std::string& who) {
+  if (feed.lattice()) {
+    EXPECT_EQ(w.z, read_all(t, *feed.lattice(), feed.z_ref())) << who;
+  } else if (feed.mesh_tiles() > 0) {
+    const std::vector<Face> tiled = tile_faces(w), whole = mesh_faces(t.mesh(), feed.origin());
+    EXPECT_EQ(tiled.size(), whole.size()) << who;
+    EXPECT_TRUE(tiled == whole) << who << ": the tiles' faces differ from the whole mesh's";
+  } else {
+    ASSERT_TRUE(feed.mesh()) << who;
+    expect_same_mesh(feed.mesh()->mesh, t.mesh(), who);
+  }
+}
+
 TEST(DisplayFeed, IncrementalCopyEqualsAFullReadOnEveryBackEnd) {
   const Scene s = parse_scene(test::flat_sand_scene("0.4", "0.1", test::kDisk2cm, R"(
 [stroke]
@@ -64,9 +127,15 @@ cell_m = 0.002
                               "test", {});
   const HeightField field = HeightField::from_scene(s);
   const ErosionRule rule = test::rule_of(s);
-  for (const std::string backend : {"grid", "sparse", "tin"}) {
-    auto t = make_terrain(backend, s, field);
-    DisplayFeed feed(*t, 0.1);
+  struct Case {
+    std::string backend;
+    bool tiles;
+  };
+  for (const Case& c : {Case{"grid", true}, Case{"sparse", true}, Case{"tin", true}, Case{"tin", false}}) {
+    const std::string who = c.backend + (c.tiles ? "" : " whole");
+    auto t = make_terrain(c.backend, s, field);
+    DisplayFeed feed(*t, 0.1, s.domain.box(), c.tiles);
+    EXPECT_EQ(feed.mesh_tiles() > 0, c.backend == "tin" && c.tiles) << who;
     std::vector<double> times;
     ASSERT_TRUE(feed.publish(*t, true, times));
     WindowCopy window;
@@ -79,25 +148,21 @@ cell_m = 0.002
       times.push_back(i);
       sent.push_back(i);
       t->erode(rule, {.max_passes = 4});
+      if (i % 5 == 4) t->simplify({});
       if (i % 2 == 0) feed.publish(*t, true, times);  // some changes published in the next one
-      if (i % 3 == 0) {
-        if (feed.lattice()) window.take(feed, feed.lattice()->nx);  // some publications taken together
-      }
+      if (i % 3 == 0) window.take(feed);              // some publications taken together
     }
     t->erode(rule, {.max_passes = 64, .settling = true});
     feed.publish(*t, true, times);
+    window.take(feed);
+    expect_copy_of(window, feed, *t, who);
+    EXPECT_EQ(window.stamp_times_s, sent) << who;
     if (feed.lattice()) {
-      window.take(feed, feed.lattice()->nx);
-      EXPECT_EQ(window.z, read_all(*t, *feed.lattice(), 0.1)) << backend;
-      EXPECT_EQ(window.stamp_times_s, sent) << backend;
       LatticeUpdate none;
-      EXPECT_FALSE(feed.take(none)) << backend << ": nothing left pending";
-    } else {
-      LatticeUpdate u;
-      feed.take(u);
-      EXPECT_EQ(u.stamp_times_s, sent) << backend;
-      ASSERT_TRUE(feed.mesh()) << backend;
-      expect_same_mesh(feed.mesh()->mesh, t->mesh(), backend);
+      EXPECT_FALSE(feed.take(none)) << who << ": nothing left pending";
+    } else if (feed.mesh_tiles() > 0) {
+      MeshTileUpdate none;
+      EXPECT_FALSE(feed.take(none)) << who << ": nothing left pending";
     }
   }
 }
@@ -126,7 +191,7 @@ TEST(DisplayFeed, SimulationTracksTheVolumeAndFeedsTheWholeSurface) {
     servo.start();
     sim.start();
     for (int i = 0; i < 400 && !device.finished(); ++i) {
-      if (feed.lattice()) window.take(feed, feed.lattice()->nx);
+      window.take(feed);
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
@@ -137,14 +202,9 @@ TEST(DisplayFeed, SimulationTracksTheVolumeAndFeedsTheWholeSurface) {
     EXPECT_GE(totals.stamps, 5u) << backend;
     EXPECT_GT(totals.display_ms.size(), 1u) << backend;
     EXPECT_NEAR(totals.volume_tracked_m3, totals.volume_final_m3, 1e-12 * totals.volume_initial_m3) << backend;
-    if (feed.lattice()) {
-      window.take(feed, feed.lattice()->nx);
-      EXPECT_EQ(window.z, read_all(sim.terrain(), *feed.lattice(), feed.z_ref())) << backend;
-      EXPECT_EQ(window.stamp_times_s.size(), totals.stamps) << backend;
-    } else {
-      ASSERT_TRUE(feed.mesh()) << backend;
-      expect_same_mesh(feed.mesh()->mesh, sim.terrain().mesh(), backend);
-    }
+    window.take(feed);
+    expect_copy_of(window, feed, sim.terrain(), backend);
+    EXPECT_EQ(window.stamp_times_s.size(), totals.stamps) << backend;
   }
 }
 

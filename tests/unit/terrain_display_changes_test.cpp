@@ -2,12 +2,17 @@
 // each built through sb::make_terrain (grid in double and float, sparse): after random stamps,
 // erosion steps and settling with the cascade, every node whose height changed lies in a
 // rectangle the terrain reported; a stamp reports only tiles near its footprint; a terrain left
-// alone reports nothing. The TIN has no lattice and does not track (a display rebuilds its mesh).
+// alone reports nothing. The TIN has no lattice; every face it adds or removes has its centroid in a
+// region it reports.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <iterator>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "common/height_field.hpp"
@@ -127,12 +132,117 @@ TEST(DisplayChanges, EveryChangedHeightIsInAReportedTileAfterRandomStrokes) {
   }
 }
 
-TEST(DisplayChanges, TheTinHasNoLatticeAndDoesNotTrack) {
-  const Scene s = lattice_scene({});
-  const HeightField field = HeightField::from_scene(s);
-  auto t = make_terrain("tin", s, field);
-  EXPECT_FALSE(t->lattice());
-  EXPECT_FALSE(t->changes_since(0).tracked);
+// A face as its corners, starting from the least (the same face, however a mesh lists it).
+using Face = std::array<double, 9>;
+std::vector<Face> faces_of(const Terrain& t) {
+  const SurfaceMesh m = t.mesh();
+  std::vector<Face> faces;
+  for (const auto& tri : m.triangles) {
+    std::size_t first = 0;
+    for (std::size_t c = 1; c < 3; ++c) {
+      const Vec3 &a = m.vertices[tri[c]], &b = m.vertices[tri[first]];
+      if (std::make_tuple(a.x(), a.y(), a.z()) < std::make_tuple(b.x(), b.y(), b.z())) first = c;
+    }
+    Face f;
+    for (std::size_t c = 0; c < 3; ++c) {
+      const Vec3& v = m.vertices[tri[(first + c) % 3]];
+      for (std::size_t a = 0; a < 3; ++a) f[3 * c + a] = v[static_cast<Eigen::Index>(a)];
+    }
+    faces.push_back(f);
+  }
+  std::sort(faces.begin(), faces.end());
+  return faces;
+}
+
+// Every face added or removed has its centroid in a reported region; returns how many changed.
+std::size_t expect_faces_covered(const std::vector<Face>& before, const std::vector<Face>& after,
+                                 const SurfaceChanges& c, const std::string& what) {
+  EXPECT_TRUE(c.tracked) << what;
+  std::vector<Face> changed;
+  std::set_symmetric_difference(before.begin(), before.end(), after.begin(), after.end(), std::back_inserter(changed));
+  std::size_t missed = 0;
+  for (const Face& f : changed) {
+    const Vec2 centroid((f[0] + f[3] + f[6]) / 3.0, (f[1] + f[4] + f[7]) / 3.0);
+    bool in = false;
+    for (const Aabb2& r : c.regions) in = in || r.contains(centroid);
+    if (!in) ++missed;
+  }
+  EXPECT_EQ(missed, 0u) << what << ": " << missed << " of " << changed.size()
+                        << " changed faces with their centroid outside the reported regions";
+  return changed.size();
+}
+
+// The TIN's changes after every edit of random strokes: tools from a disk to one under its
+// refinement length, each displacement model, headings all round, erosion, settling (the
+// cascade), simplification, and a dunes TIN whose rest coarsens it.
+TEST(DisplayChanges, EveryChangedTinFaceHasItsCentroidInAReportedRegion) {
+  struct Case {
+    std::string name;
+    std::string tool;
+    std::string terrain;  // extra scene text
+  };
+  const Case cases[] = {
+      {"disk rim", std::string(test::kDisk2cm), ""},
+      {"disk rim, no volume give-back", std::string(test::kDisk2cm), "[tin]\nconserve_volume = false\n"},
+      {"disk carry", "shape = \"disk\"\nradius_m = 0.02\ndepth_m = 0.01\n", ""},
+      {"box bulldoze", "shape = \"box\"\nsize_m = [0.02, 0.03]\ndepth_m = 0.012\ndisplacement = \"bulldoze\"\n", ""},
+      {"disk under refine_m", "shape = \"disk\"\nradius_m = 0.0015\ndepth_m = 0.002\n", ""},
+      {"dunes, coarsening", "shape = \"disk\"\nradius_m = 0.02\ndepth_m = 0.01\n", "[tin]\ncoarsen = true\n"},
+  };
+  for (const Case& k : cases) {
+    std::vector<std::string> overrides;
+    if (k.name.rfind("dunes", 0) == 0)
+      overrides = {"terrain.kind=dunes", "terrain.wavelength_m=0.15", "terrain.amplitude_m=0.01"};
+    const Scene s = parse_scene(
+        test::flat_sand_scene("0.4", "0.1", k.tool, "[stroke]\npath_m = [[0.1, 0.2], [0.2, 0.2]]\n" + k.terrain),
+        "test", overrides);
+    const HeightField field = HeightField::from_scene(s);
+    auto t = make_terrain("tin", s, field);
+    EXPECT_FALSE(t->lattice());
+    SurfaceChanges first = t->changes_since(0);
+    ASSERT_TRUE(first.tracked) << k.name;
+    ASSERT_FALSE(first.regions.empty()) << k.name << ": the first call reports everything";
+    std::uint64_t version = t->changes_since(first.version).version;
+    EXPECT_TRUE(t->changes_since(version).regions.empty()) << k.name << ": nothing happened";
+    version = t->changes_since(version).version;
+
+    const ErosionRule rule = test::rule_of(s);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> pos(0.04, 0.36), depth(0.003, 0.012), angle(0.0, 6.283185307179586);
+    std::vector<Face> before = faces_of(*t);
+    std::size_t changed_total = 0;
+    const auto check = [&](const std::string& what) {
+      const SurfaceChanges c = t->changes_since(version);
+      version = c.version;
+      std::vector<Face> after = faces_of(*t);
+      changed_total += expect_faces_covered(before, after, c, k.name + " " + what);
+      before = std::move(after);
+    };
+    Vec2 xy(pos(rng), pos(rng));
+    for (int i = 0; i < 24; ++i) {
+      // Strokes of 6 stamps 4 mm apart, each in a random direction from a random start.
+      const double a = angle(rng);
+      const Vec2 motion(std::cos(a), std::sin(a));
+      if (i % 6 == 0) xy = Vec2(pos(rng), pos(rng));
+      xy += 0.004 * motion;
+      t->stamp(test::stamp_at(s, xy, 0.1 - depth(rng), motion, static_cast<std::uint32_t>(i / 6 + 1)));
+      check("stamp " + std::to_string(i));
+      t->erode(rule, {.max_passes = 4});
+      check("erosion after stamp " + std::to_string(i));
+      if (i % 3 == 2) {
+        t->simplify(SimplifyParams{s.tin.alpha_flat_deg});
+        check("simplification after stamp " + std::to_string(i));
+      }
+      if (i % 6 == 5) {
+        t->erode(rule, {.max_passes = 64, .settling = true});
+        check("settling after stamp " + std::to_string(i));
+        t->simplify(SimplifyParams{s.tin.alpha_flat_deg});
+        check("simplification at rest after stamp " + std::to_string(i));
+      }
+    }
+    EXPECT_GT(changed_total, 500u) << k.name << ": the strokes changed the mesh";
+    EXPECT_TRUE(t->changes_since(version).regions.empty()) << k.name << ": left alone, nothing changes";
+  }
 }
 
 }  // namespace

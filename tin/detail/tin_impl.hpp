@@ -19,6 +19,7 @@
 #include "common/height_field.hpp"
 #include "common/scene.hpp"
 #include "common/terrain.hpp"
+#include "tin/detail/change_cells.hpp"
 
 namespace sb::tin::detail {
 
@@ -33,7 +34,8 @@ struct VertexInfo {
   std::uint32_t simplify_slot = kNoSlot;  // index in L_r, or kNoSlot
   std::uint32_t mark = 0;                 // traversal epoch (see TinTerrain::next_vertex_epoch)
   std::uint16_t idle = 0;                 // erosion visits without a transfer
-  std::uint8_t border = 0;                // on the domain boundary: never removed
+  std::uint8_t border : 1 = 0;            // on the domain boundary: never removed
+  std::uint8_t display_pending : 1 = 0;   // its height changed since a display last asked (TinTerrain::set_z)
   std::uint8_t short_edges = 0;           // 1: no edge longer than refine_m_ (valid with area)
 };
 
@@ -166,6 +168,9 @@ class TinTerrain final : public Terrain {
   void sample(Raster& out) const override;
   IntegrityReport check() const override;
   double max_slope_deg() const override;
+  // display.cpp: the cells whose faces changed (ChangeCells), and the faces in a box.
+  SurfaceChanges changes_since(std::uint64_t version) override;
+  void surface_faces(const Aabb2& box, std::vector<Vec3>& out) const override;
 
  private:
   // mesh_ops.cpp: location, insertion, removal, constraints, lists, captures.
@@ -229,6 +234,14 @@ class TinTerrain final : public Terrain {
     return in.area;
   }
   void forget_star(VertexHandle v);
+  // For a display (changes_): the faces in `box` changed; the faces around v changed (O(degree)
+  // while a display tracks, else O(1)). Every edit of the triangulation or a height marks what
+  // it changed: insert_point, remove_vertex (and its flips), end_capture (constraints), and
+  // set_z, which only lists the vertex (display_pending_): erosion writes a vertex many times
+  // between two display updates, and changes_since marks each listed vertex's star once.
+  void mark_changed(const Aabb2& box) { changes_.mark(box); }
+  void mark_star(VertexHandle v);
+  void mark_pending_stars();
   // v's cached area, short-edge flag and ring forgotten: its star changed.
   void forget_caches(VertexHandle v) {
     VertexInfo& in = v->info();
@@ -267,7 +280,7 @@ class TinTerrain final : public Terrain {
   void drop_from_erosion(VertexHandle v);
   void add_to_simplify(VertexHandle v);
   void drop_from_simplify(VertexHandle v);
-  std::uint32_t next_face_epoch();
+  std::uint32_t next_face_epoch() const;
   std::uint32_t next_vertex_epoch();
 
   // stamp.cpp: the paper's steps 1a-1f, in the order stamp() takes them.
@@ -405,6 +418,10 @@ class TinTerrain final : public Terrain {
   double base_height_m_ = 0.0;
 
   Cdt cdt_;
+  ChangeCells changes_{box_};  // for displays (changes_since)
+  // Vertices whose height changed since changes_since last ran (a removed one's slot may have
+  // been freed or reused: checked when read).
+  std::vector<VertexHandle> display_pending_;
   std::unordered_map<EdgeKey, std::uint32_t, EdgeKeyHash> generations_;  // constrained edges
   std::vector<ErosionEntry> erosion_list_;                               // L_e
   // The cached rings of L_e's vertices (ErosionEntry::ring), and how many of its slots belong
@@ -416,7 +433,7 @@ class TinTerrain final : public Terrain {
   std::size_t hull_vertices_ = 0;        // border vertices (all on the convex hull)
   mutable Walk edit_walk_, query_walk_;  // (see Walk)
   mutable std::uint64_t walk_steps_ = 0;
-  std::uint32_t face_epoch_ = 0;
+  mutable std::uint32_t face_epoch_ = 0;  // (surface_faces, a query, walks by face marks too)
   std::uint32_t vertex_epoch_ = 0;
   std::size_t capture_mismatches_ = 0;  // regions whose area changed: a broken assumption
   // The volume change of the current phase (stamp, erode, simplify) from the edits' own
