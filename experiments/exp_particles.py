@@ -328,7 +328,7 @@ def run(ctx):
         case = {"case": ref.case, "scene": ref.scene, "mean": ref.mean("final"), "surfaces": final,
                 "x": ref.xs(), "y": ref.ys(), "backends": backends, "sections": None, "seeds": len(ref.seeds),
                 "dem_cost_s": float(np.median(ref.cpu_seconds())), "dem_seeds": seeds,
-                "critical": scene["material"]["critical_angle_deg"],
+                "critical": scene["material"]["critical_angle_deg"], "tool_depth_m": scene["tool"].get("depth_m"),
                 "cost_s": {label: summaries[run_name(ref, label)]["time_s.total"] +
                            summaries[run_name(ref, label)].get("time_s.relax", 0.0) for label in names},
                 "dilation": dilation(ref, scene, lattice)}
@@ -418,6 +418,11 @@ def values(cases, table, figures, other, others):
                          "verdict": ("the shared tool model: the back-ends agree far better with each other "
                                      "than with the grains" if shared else
                                      "partly the discretisation: back-ends differ by much of it")})
+            # Grains deeper than the tool by more than the floor's bar: no height field cut to the tool follows.
+            floor = float(np.mean([s["floor_m"] for s in c["dem_seeds"]]))
+            below = -floor - (c.get("tool_depth_m") or float("inf"))
+            if below > BARS[0][2]:
+                item["floor_below_tool_mm"] = below * 1e3
             for b in BACKENDS:  # the report's summary table joins the cases' cells
                 summary.setdefault(b, {}).setdefault("accuracy vs particle sand", [])
                 summary[b]["accuracy vs particle sand"].append(f"{c['case']} {rmse[b] * 1e3:.1f} mm")
@@ -430,7 +435,8 @@ def values(cases, table, figures, other, others):
                          "more than 1 degree off"})
         out_cases.append(item)
     summary = {b: {col: "section RMSE " + ", ".join(cells) for col, cells in cols.items()} for b, cols in summary.items()}
-    return {"cases": out_cases, "table": table, "figures": figures, "summary": summary}
+    verdicts = list(dict.fromkeys(c["verdict"] for c in out_cases if "verdict" in c))
+    return {"cases": out_cases, "table": table, "figures": figures, "summary": summary, "verdicts": verdicts}
 
 
 if __name__ == "__main__":

@@ -126,7 +126,7 @@ class InteractiveScaling(unittest.TestCase):
         self.assertIn("**Verdict.**", text)
         self.assertIn("**Method or code:**", text)
         self.assertIn("llvmpipe", text)
-        self.assertIn("on dunes 45 at\n23000 vertices", text)
+        self.assertIn("on dunes 45 fps\nat 23000 vertices", text)
         self.assertIn("Skipped: no display", report.render("interactive_scaling", {"skipped": "no display"}))
 
 
