@@ -39,5 +39,8 @@ struct StepRecord {
 
 // Percentile by linear interpolation between order statistics; q in [0, 1]. 0 when empty.
 double percentile(std::vector<double> values, double q);
+// CPU seconds the calling thread has run (CLOCK_THREAD_CPUTIME_ID): a span's work without the
+// time it waited for a core on a shared machine.
+double thread_cpu_seconds();
 
 }  // namespace sb

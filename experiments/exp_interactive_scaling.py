@@ -53,6 +53,7 @@ COLUMNS = [("fps", "fps", "fps"), ("frame_p50", "frame ms p50", "frame_ms.p50"),
            ("latency_p95", "stamp to frame ms p95", "stamp_to_frame_ms.p95"),
            ("latency_max", "stamp to frame ms max", "stamp_to_frame_ms.max"),
            ("step_p50", "sim step ms p50", "sim.step_ms.p50"), ("step_p95", "sim step ms p95", "sim.step_ms.p95"),
+           ("step_cpu_p95", "sim step CPU ms p95", "sim.step_cpu_ms.p95"),
            ("display_p50", "display ms p50", "display_ms.p50"), ("display_p95", "display ms p95", "display_ms.p95"), ("upload_p95", "upload ms p95", "upload_ms.p95"),
            ("stamps", "stamps", "sim.stamps"), ("steps", "sim steps", "sim.steps")]
 
@@ -266,6 +267,9 @@ def values(ctx, rows, renderer, costs=None):
                           f"{'vertices' if b == 'tin' else 'nodes'}, {WINDOW[0]}x{WINDOW[1]}"}
     # How many median frames a stamp waits to be shown (p95), over the runs that stamped.
     lags = [r["latency_p95"] / r["frame_p50"] for r in rows.values() if r["stamps"] > 0 and r["frame_p50"] > 0]
+    # The step bar's ratio on the thread's CPU clock: what the steps cost without waiting for a core.
+    cpu_ratio = {b: rows[(b, *FINE)]["step_cpu_p95"] / rows[(b, *COARSE)]["step_cpu_p95"] for b in LATTICE_BACKENDS
+                 if (b, *FINE) in rows and (b, *COARSE) in rows and rows[(b, *COARSE)]["step_cpu_p95"] > 0}
     tin = [rows[c] for c in todo if c[0] == "tin" and c[1] == 1.0 and not on_dunes(c)]
     dunes = [rows[c] for c in todo if on_dunes(c)]
     return {"skipped": "", "png": png, "table": md, "renderer": renderer, "window": f"{WINDOW[0]} x {WINDOW[1]}",
@@ -275,7 +279,7 @@ def values(ctx, rows, renderer, costs=None):
                        "display_p50": r["display_p50"]} for r in dunes],
             "frames": FRAMES, "bars": bars, "bars_table": bars_table(bars) if bars else "",
             "met": sum(b["met"] for b in bars), "rows": {case_name(c): r for c, r in rows.items()},
-            "costs": costs or {}, "summary": summary}
+            "costs": costs or {}, "summary": summary, "cpu_ratio": cpu_ratio}
 
 
 if __name__ == "__main__":

@@ -140,6 +140,7 @@ void Simulation::step() {
 
   bool worked = false, changed = false;
   if (!active_.paused) {
+    const double cpu_start_s = thread_cpu_seconds();
     Stopwatch sw;
     const bool stamped = maybe_stamp(s);
     const double tool_ms = 1e3 * sw.seconds();
@@ -165,6 +166,7 @@ void Simulation::step() {
     if (worked) {
       const double total = tool_ms + erosion_ms + simplify_ms;
       totals_.step_ms.push_back(total);
+      totals_.step_cpu_ms.push_back(1e3 * (thread_cpu_seconds() - cpu_start_s));
       ++totals_.steps;
       recent_ms_[recent_next_++ % kRecentSteps] = total;
       std::lock_guard lock(mutex_);

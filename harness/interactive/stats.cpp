@@ -62,6 +62,8 @@ Json haptic_stats_json(const haptics::ServoStats& s, const haptics::DeviceLimits
   j["sim.step_ms.p50"] = percentile(sim.step_ms, 0.5);
   j["sim.step_ms.p95"] = percentile(sim.step_ms, 0.95);
   j["sim.step_ms.max"] = sim.step_ms.empty() ? 0.0 : *std::max_element(sim.step_ms.begin(), sim.step_ms.end());
+  j["sim.step_cpu_ms.p50"] = percentile(sim.step_cpu_ms, 0.5);
+  j["sim.step_cpu_ms.p95"] = percentile(sim.step_cpu_ms, 0.95);
   j["patches"] = sim.patches;
   j["patch_ms.p50"] = percentile(sim.patch_ms, 0.5);
   j["patch_ms.p95"] = percentile(sim.patch_ms, 0.95);

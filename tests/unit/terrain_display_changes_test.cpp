@@ -245,5 +245,31 @@ TEST(DisplayChanges, EveryChangedTinFaceHasItsCentroidInAReportedRegion) {
   }
 }
 
+// On a TIN of 40 000 vertices (a 1 m square), what a stamp and its erosion report stays near
+// them: the boxes cover about a hundredth of the domain, so a display reads that much again.
+TEST(DisplayChanges, ATinStampReportsOnlyItsNeighbourhood) {
+  const Scene s = parse_scene(test::flat_sand_scene("1.0", "0.1", "shape = \"disk\"\nradius_m = 0.02\ndepth_m = 0.01\n",
+                                                    "[stroke]\npath_m = [[0.4, 0.5], [0.6, 0.5]]\n"),
+                              "test", {"tin.initial_points=40000"});
+  auto t = make_terrain("tin", s, HeightField::from_scene(s));
+  std::uint64_t version = t->changes_since(0).version;
+  const ErosionRule rule = test::rule_of(s);
+  for (int i = 0; i < 10; ++i) {
+    const Vec2 xy(0.4 + 0.004 * i, 0.5);
+    t->stamp(test::stamp_at(s, xy, 0.09, {1.0, 0.0}, 1));
+    t->erode(rule, {.max_passes = 4});
+    t->simplify(SimplifyParams{s.tin.alpha_flat_deg});
+    const SurfaceChanges c = t->changes_since(version);
+    version = c.version;
+    ASSERT_FALSE(c.regions.empty());
+    double area = 0.0;
+    for (const Aabb2& r : c.regions) {
+      area += (r.hi - r.lo).prod();
+      EXPECT_LT((0.5 * (r.lo + r.hi) - xy).norm(), 0.15) << "stamp " << i << ": a region far from the tool";
+    }
+    EXPECT_LT(area, 0.02) << "stamp " << i << ": m^2 reported, of a 1 m^2 domain";
+  }
+}
+
 }  // namespace
 }  // namespace sb
