@@ -267,12 +267,7 @@ void TinTerrain::remove_vertex(VertexHandle v) {
     else
       link_scratch_.push_back(c);
   } while (++c != done);
-  // The hole is filled inside the link (and, on the hull, its border edge).
-  if (changes_.tracking()) {
-    Aabb2 hole{xy(v), xy(v)};
-    for (VertexHandle w : link_scratch_) hole = united(hole, Aabb2{xy(w), xy(w)});
-    mark_changed(hole);
-  }
+  mark_star(v);  // the hole is filled inside the link (and, on the hull, its border edge)
   if (on_hull)
     cdt_.remove(v);
   else
@@ -335,11 +330,7 @@ void TinTerrain::remove_by_flips(VertexHandle v) {
     if (!cdt_.is_edge(a, b, f, i) || !cdt_.is_flipable(f, i)) continue;
     const VertexHandle c = f->vertex(i), d = f->neighbor(i)->vertex(cdt_.mirror_index(f, i));
     cdt_.flip(f, i);
-    if (changes_.tracking()) {
-      Aabb2 quad{xy(a), xy(a)};
-      for (VertexHandle w : {b, c, d}) quad = united(quad, Aabb2{xy(w), xy(w)});
-      mark_changed(quad);
-    }
+    if (changes_.tracking()) mark_changed(united(united(box_of(a), box_of(b)), united(box_of(c), box_of(d))));
     diagonals.insert(diagonals.end(), {{a, c}, {c, b}, {b, d}, {d, a}});
   }
 }
@@ -452,10 +443,10 @@ void TinTerrain::mark_pending_stars() {
 
 void TinTerrain::mark_star(VertexHandle v) {
   if (!changes_.tracking()) return;
-  Aabb2 star{xy(v), xy(v)};
+  Aabb2 star = box_of(v);
   auto c = cdt_.incident_vertices(v), done = c;
   do {
-    if (!cdt_.is_infinite(c)) star = united(star, Aabb2{xy(c), xy(c)});
+    if (!cdt_.is_infinite(c)) star = united(star, box_of(c));
   } while (++c != done);
   mark_changed(star);
 }
@@ -564,9 +555,9 @@ CaptureResult TinTerrain::end_capture(Capture& c, std::vector<VertexHandle>* reg
   // What the edits in between changed lies in the region (constraints' flips included).
   if (changes_.tracking()) {
     if (!intact) changes_.mark_all();
-    Aabb2 region{xy(start->vertex(0)), xy(start->vertex(0))};
+    Aabb2 region = box_of(start->vertex(0));
     for (const FaceHandle f : face_scratch_)
-      for (int i = 0; i < 3; ++i) region = united(region, Aabb2{xy(f->vertex(i)), xy(f->vertex(i))});
+      for (int i = 0; i < 3; ++i) region = united(region, box_of(f->vertex(i)));
     mark_changed(region);
   }
   if (!intact || std::abs(r.area_after - r.area_before) > 1e-9 * std::max(r.area_before, 1e-30)) {
@@ -578,28 +569,15 @@ CaptureResult TinTerrain::end_capture(Capture& c, std::vector<VertexHandle>* reg
 
 void TinTerrain::collect_vertices(const Aabb2& box, std::vector<VertexHandle>& out) {
   out.clear();
-  const std::uint32_t visited = next_face_epoch();
   const std::uint32_t seen = next_vertex_epoch();
-  const Location loc = locate(clamp_to_domain(0.5 * (box.lo + box.hi)));
-  std::vector<FaceHandle>& queue = face_scratch_;
-  queue.clear();
-  queue.push_back(loc.face);
-  loc.face->info() = visited;
-  for (std::size_t k = 0; k < queue.size(); ++k) {
-    const FaceHandle f = queue[k];
+  visit_faces_overlapping(box, clamp_to_domain(0.5 * (box.lo + box.hi)), edit_walk_, face_scratch_, [&](FaceHandle f) {
     for (int i = 0; i < 3; ++i) {
       const VertexHandle v = f->vertex(i);
-      if (v->info().mark != seen) {
-        v->info().mark = seen;
-        if (box.contains(xy(v))) out.push_back(v);
-      }
-      const FaceHandle n = f->neighbor(i);
-      if (cdt_.is_infinite(n) || n->info() == visited) continue;
-      if (!face_overlaps(n, box)) continue;
-      n->info() = visited;
-      queue.push_back(n);
+      if (v->info().mark == seen) continue;
+      v->info().mark = seen;
+      if (box.contains(xy(v))) out.push_back(v);
     }
-  }
+  });
 }
 
 std::span<const VertexHandle> TinTerrain::fill_ring(VertexHandle v) {

@@ -1,7 +1,6 @@
 #include "harness/interactive/display_feed.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <limits>
 
 namespace sb {
@@ -15,23 +14,14 @@ constexpr std::size_t kTile = 64;  // the feed's pending tiles: nodes per side
 DisplayFeed::DisplayFeed(Terrain& terrain, double z_ref, const Aabb2& domain, bool tiles)
     : lattice_(tiles ? terrain.lattice() : std::nullopt),
       z_ref_(z_ref),
-      domain_(domain),
-      origin_(0.5 * (domain.lo.x() + domain.hi.x()), 0.5 * (domain.lo.y() + domain.hi.y()), z_ref) {
+      origin_(0.5 * (domain.lo.x() + domain.hi.x()), 0.5 * (domain.lo.y() + domain.hi.y()), z_ref),
+      mesh_grid_(domain, kMeshTiles) {
   if (tiles && !lattice_) {
     // A mesh by tiles only from a back-end that tracks its changes (this call starts it).
     const SurfaceChanges c = terrain.changes_since(0);
     if (!c.tracked) return;
     version_ = c.version;
-    const double w = domain.hi.x() - domain.lo.x(), h = domain.hi.y() - domain.lo.y();
-    const auto side = [&](double l) {
-      const double longest = std::max(w, h);
-      return longest > 0.0
-                 ? std::clamp<std::size_t>(static_cast<std::size_t>(std::ceil(kMeshTiles * l / longest)), 1, kMeshTiles)
-                 : std::size_t{1};
-    };
-    mesh_cols_ = side(w);
-    mesh_rows_ = side(h);
-    mesh_tiles_.resize(mesh_cols_ * mesh_rows_);
+    mesh_tiles_.resize(mesh_grid_.size());
     pending_.assign(mesh_tiles_.size(), 0);
     return;
   }
@@ -98,24 +88,14 @@ bool DisplayFeed::take(LatticeUpdate& out) {
   return true;
 }
 
-namespace {
-
-// Edge k of n tiles along an axis from lo: the outer edges at infinity (the tiles share out
-// every face, however near the border its centroid lies).
-double tile_edge(std::size_t k, std::size_t n, double lo, double extent) {
-  if (k == 0) return -std::numeric_limits<double>::infinity();
-  if (k == n) return std::numeric_limits<double>::infinity();
-  return lo + extent * static_cast<double>(k) / static_cast<double>(n);
-}
-
-}  // namespace
-
 Aabb2 DisplayFeed::mesh_tile_box(std::size_t tile) const {
-  const std::size_t i = tile % mesh_cols_, j = tile / mesh_cols_;
-  const Vec2 size = domain_.hi - domain_.lo;
-  return {
-      {tile_edge(i, mesh_cols_, domain_.lo.x(), size.x()), tile_edge(j, mesh_rows_, domain_.lo.y(), size.y())},
-      {tile_edge(i + 1, mesh_cols_, domain_.lo.x(), size.x()), tile_edge(j + 1, mesh_rows_, domain_.lo.y(), size.y())}};
+  // The border tiles reach to infinity: together the tiles share out every face, however near
+  // the domain's side its centroid lies.
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const DomainTiles& g = mesh_grid_;
+  const std::size_t i = tile % g.cols(), j = tile / g.cols();
+  return {{i == 0 ? -inf : g.x_edge(i), j == 0 ? -inf : g.y_edge(j)},
+          {i + 1 == g.cols() ? inf : g.x_edge(i + 1), j + 1 == g.rows() ? inf : g.y_edge(j + 1)}};
 }
 
 bool DisplayFeed::publish_mesh_tiles(Terrain& terrain, std::vector<double>& stamp_times_s) {
@@ -127,17 +107,11 @@ bool DisplayFeed::publish_mesh_tiles(Terrain& terrain, std::vector<double>& stam
     const SurfaceChanges c = terrain.changes_since(version_);
     version_ = c.version;
     std::vector<std::uint8_t> hit(mesh_tiles_.size(), 0);
-    const Vec2 size = domain_.hi - domain_.lo;
-    const auto index = [](double u, std::size_t n) {
-      return u > 0.0 ? std::min(static_cast<std::size_t>(u * static_cast<double>(n)), n - 1) : std::size_t{0};
-    };
+    const DomainTiles& g = mesh_grid_;
     for (const Aabb2& r : c.regions) {
-      const std::size_t x0 = index((r.lo.x() - domain_.lo.x()) / size.x(), mesh_cols_);
-      const std::size_t x1 = index((r.hi.x() - domain_.lo.x()) / size.x(), mesh_cols_);
-      const std::size_t y0 = index((r.lo.y() - domain_.lo.y()) / size.y(), mesh_rows_);
-      const std::size_t y1 = index((r.hi.y() - domain_.lo.y()) / size.y(), mesh_rows_);
-      for (std::size_t y = y0; y <= y1; ++y)
-        for (std::size_t x = x0; x <= x1; ++x) hit[y * mesh_cols_ + x] = 1;
+      const std::size_t x0 = g.col(r.lo.x()), x1 = g.col(r.hi.x());
+      for (std::size_t y = g.row(r.lo.y()); y <= g.row(r.hi.y()); ++y)
+        for (std::size_t x = x0; x <= x1; ++x) hit[y * g.cols() + x] = 1;
     }
     for (std::size_t t = 0; t < hit.size(); ++t)
       if (hit[t]) dirty.push_back(static_cast<std::uint32_t>(t));
@@ -146,18 +120,18 @@ bool DisplayFeed::publish_mesh_tiles(Terrain& terrain, std::vector<double>& stam
   // Each run of neighbouring dirty tiles in a row read in one walk, its faces dealt out to the
   // tiles by their centroids' column (a large face is visited once, not once per tile it spans).
   std::vector<std::vector<float>> faces(dirty.size());
-  const double lo_x = domain_.lo.x(), extent_x = domain_.hi.x() - domain_.lo.x();
+  const std::size_t cols = mesh_grid_.cols();
   for (std::size_t first = 0; first < dirty.size();) {
     std::size_t last = first;
-    while (last + 1 < dirty.size() && dirty[last + 1] == dirty[last] + 1 && dirty[last + 1] % mesh_cols_ != 0) ++last;
+    while (last + 1 < dirty.size() && dirty[last + 1] == dirty[last] + 1 && dirty[last + 1] % cols != 0) ++last;
     const Aabb2 box{mesh_tile_box(dirty[first]).lo, mesh_tile_box(dirty[last]).hi};
-    const std::size_t col0 = dirty[first] % mesh_cols_;
+    const std::size_t col0 = dirty[first] % cols;
     faces_scratch_.clear();
     terrain.surface_faces(box, faces_scratch_);
     for (std::size_t f = 0; f + 3 <= faces_scratch_.size(); f += 3) {
+      // The tile whose columns hold the centroid, as surface_faces decided by the same edges.
       const double x = (faces_scratch_[f].x() + faces_scratch_[f + 1].x() + faces_scratch_[f + 2].x()) / 3.0;
-      std::size_t k = first;  // the tile whose [edge, next edge) holds x, as surface_faces decided
-      while (k < last && x >= tile_edge(col0 + (k - first) + 1, mesh_cols_, lo_x, extent_x)) ++k;
+      const std::size_t k = first + std::clamp(mesh_grid_.col(x), col0, col0 + (last - first)) - col0;
       for (std::size_t c = f; c < f + 3; ++c) {
         const Vec3 q = faces_scratch_[c] - origin_;
         faces[k].insert(faces[k].end(),

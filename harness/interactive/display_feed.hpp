@@ -27,6 +27,7 @@
 #include <optional>
 #include <vector>
 
+#include "common/domain_tiles.hpp"
 #include "common/terrain.hpp"
 
 namespace sb {
@@ -99,9 +100,8 @@ class DisplayFeed {
 
   std::optional<HeightLattice> lattice_;
   double z_ref_;
-  Aabb2 domain_;
   Vec3 origin_;
-  std::size_t mesh_cols_ = 0, mesh_rows_ = 0;
+  DomainTiles mesh_grid_;           // a mesh's tiles (used when mesh_tiles_ is not empty)
   std::uint64_t version_ = 0;       // the terrain's change version last read (simulation thread)
   std::uint64_t mesh_version_ = 0;  // meshes published
   bool first_ = true;

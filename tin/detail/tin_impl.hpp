@@ -254,6 +254,12 @@ class TinTerrain final : public Terrain {
   CaptureResult end_capture(Capture& c, std::vector<VertexHandle>* region_vertices = nullptr);
   // Vertices inside `box` (a traversal of the faces overlapping it).
   void collect_vertices(const Aabb2& box, std::vector<VertexHandle>& out);
+  // Calls visit(f) for every finite face overlapping `box` (closed), breadth first from the face
+  // `walk` locates at `from` (a point in the box): the faces overlapping a convex box are
+  // connected. `queue`: scratch. O(those faces).
+  template <class Visit>
+  void visit_faces_overlapping(const Aabb2& box, const Vec2& from, Walk& walk, std::vector<FaceHandle>& queue,
+                               Visit&& visit) const;
   void touch(VertexHandle v) {  // joins L_e (idle count reset); inline: erosion's hottest call
     VertexInfo& in = v->info();
     in.idle = 0;
@@ -474,5 +480,26 @@ inline bool face_overlaps(FaceHandle f, const Aabb2& box) {
 }
 inline Vec2 xy(const Point& p) { return {p.x(), p.y()}; }
 inline Vec2 xy(VertexHandle v) { return xy(v->point()); }
+inline Aabb2 box_of(VertexHandle v) { return {xy(v), xy(v)}; }
+
+template <class Visit>
+void TinTerrain::visit_faces_overlapping(const Aabb2& box, const Vec2& from, Walk& walk, std::vector<FaceHandle>& queue,
+                                         Visit&& visit) const {
+  const std::uint32_t visited = next_face_epoch();
+  FaceHandle start = locate(from, walk).face;  // (a point on the hull may locate in an infinite face)
+  if (cdt_.is_infinite(start)) start = start->neighbor(start->index(cdt_.infinite_vertex()));
+  queue.assign(1, start);
+  start->info() = visited;
+  for (std::size_t k = 0; k < queue.size(); ++k) {
+    const FaceHandle f = queue[k];
+    visit(f);
+    for (int i = 0; i < 3; ++i) {
+      const FaceHandle n = f->neighbor(i);
+      if (cdt_.is_infinite(n) || n->info() == visited || !face_overlaps(n, box)) continue;
+      n->info() = visited;
+      queue.push_back(n);
+    }
+  }
+}
 
 }  // namespace sb::tin::detail
