@@ -265,6 +265,26 @@ TEST(DensePassActiveSet, AssignBlocksIsActivateBlockPerCentre) {
   }
 }
 
+// The sparse grid's bit-plane idle counts, 64 nodes a word at once, count as one node at a time:
+// the same nodes leave on every round, for idle_passes from 1 to 9 (one to four planes, and
+// idle_passes a power of two, whose counts carry out of the planes).
+TEST(DensePassActiveSet, BitPlaneCountsAWordAsNodeByNode) {
+  for (const std::uint16_t idle_passes : {1, 2, 3, 4, 5, 8, 9}) {
+    BitPlaneIdleCounts by_node(130, 3, 3, idle_passes), by_word(130, 3, 3, idle_passes);
+    std::uint64_t h = 99 + idle_passes;
+    for (int round = 0; round < 60; ++round) {
+      const std::size_t y = static_cast<std::size_t>(round) % 3, w = static_cast<std::size_t>(round / 3) % 3;
+      h = h * 6364136223846793005ull + 1442695040888963407ull;
+      const std::uint64_t kept = h ^ (h >> 29) ^ (round % 4 == 0 ? ~std::uint64_t{0} : 0);
+      std::uint64_t expected = 0;
+      for (unsigned b = 0; b < 64; ++b)
+        if ((kept >> b) & 1u && by_node.count_up(w * 64 + b, y, idle_passes)) expected |= std::uint64_t{1} << b;
+      ASSERT_EQ(by_word.count_up_word(y, w, kept, idle_passes), expected) << idle_passes << " round " << round;
+      if (round % 7 == 6) by_node.reset(y, 10, 100), by_word.reset(y, 10, 100);
+    }
+  }
+}
+
 // Given the columns that hold every member and centre, assign_blocks leaves the words outside
 // them alone and gives the same set as over whole rows (ranges starting and ending at word
 // edges, inside words, and at the grid's edges).
