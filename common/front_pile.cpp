@@ -8,13 +8,25 @@
 
 namespace sb {
 
-bool in_front_pile(const ToolStamp& s, const Vec2& p) {
+bool in_front_pile(const ToolStamp& s, const Vec2& p, double slump_band_m) {
   const Vec2 offset = p - s.pose.xy;
   const double along = offset.dot(s.motion_dir);
   const double across = std::abs(offset.x() * s.motion_dir.y() - offset.y() * s.motion_dir.x());
-  // Carrying: beside the tool back to its rear, but not in the trench its rear half sweeps.
-  if (s.carries()) return along > 0.0 || (along > s.rear_m && across > s.half_width_m);
+  // Carrying: beside the tool back to its rear, but not in the trench its rear half sweeps, nor
+  // on the band its walls take beside it.
+  if (s.carries()) {
+    const bool beside_band = across > s.half_width_m && across <= s.half_width_m + slump_band_m;
+    return (along > 0.0 || (along > s.rear_m && across > s.half_width_m)) && !(beside_band && along <= s.front_m);
+  }
   return along > 0.0 && across <= s.half_width_m;
+}
+
+Vec2 bed_probe(const ToolStamp& s, double step_m) { return s.pose.xy + (s.front_m + step_m) * s.motion_dir; }
+
+double slump_band(const ToolStamp& s, double bed_z_m) {
+  const double depth = bed_z_m - s.pose.bottom_z, tan = s.rim.tan_repose;
+  if (!s.carries() || !(depth > 0.0) || !(tan > 0.0)) return 0.0;
+  return depth / (2.0 * tan);
 }
 
 PileDistance::PileDistance(const ToolStamp& s) {
@@ -52,7 +64,27 @@ double carried_fraction(const ToolStamp& s, const CarriedPileOrigin& previous) {
   if (!s.carries() || !previous.valid || s.generation != previous.generation + 1) return 0.0;
   const double length = s.front_m - s.rear_m, moved = (s.pose.xy - previous.xy).norm();
   if (!(length > 0.0) || !(moved <= length)) return 0.0;
-  return std::pow(1.0 - s.rim.carry_shed_fraction, moved / length);
+  return std::pow((1.0 - s.rim.carry_shed_fraction) * (1.0 - front_deflection(s)), moved / length);
+}
+
+double front_deflection(const ToolStamp& s) {
+  if (!s.carries()) return 0.0;
+  const double mu = s.rim.face_friction;
+  double width = 0.0, sliding = 0.0;
+  const std::size_t n = s.footprint.size();
+  for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
+    const Vec2 edge = s.footprint[i] - s.footprint[j];
+    const double length = edge.norm();
+    if (!(length > 0.0)) continue;
+    const Vec2 outward = Vec2(edge.y(), -edge.x()) / length;  // the footprint is counter-clockwise
+    const double cos_theta = outward.dot(s.motion_dir);
+    if (cos_theta <= 0.0) continue;  // not a front face
+    const double sin_theta = std::abs(outward.x() * s.motion_dir.y() - outward.y() * s.motion_dir.x());
+    const double w = length * cos_theta;  // the edge's width across the motion
+    width += w;
+    sliding += w * std::max(0.0, sin_theta - mu * cos_theta);
+  }
+  return width > 0.0 ? sliding / width : 0.0;
 }
 
 CarriedPileOrigin carried_origin(const ToolStamp& s) {

@@ -25,15 +25,30 @@
 // pile the stamp before it heaped: at every element of that pile outside its footprint, the sand
 // standing above the height the element had before the deposit, all but what the tool sheds,
 //
-//   kept = (1 - carry_shed_fraction)^(moved / length),   length: the footprint's along the motion
+//   kept = ((1 - carry_shed_fraction) (1 - deflection))^(moved / length),
 //
-// (what is shed stays: in the corridor the footprint cuts it again, beside it it is berm; the
-// default sheds nothing, and the berms are what erosion spills off the flanks between stamps).
+// length: the footprint's along the motion (what is left stays: in the corridor the footprint
+// cuts it again, beside it it is berm). The default sheds nothing; the deflection is what the
+// front's shape sends round the tool. Against a face whose outward normal is turned theta from
+// the motion, pushed sand slides along the face when the push's tangential part beats friction,
+// tan theta > mu (the tool's face_friction); the net sliding force per unit push is
+// sin theta - mu cos theta. Averaged over the front, weighted by the width each face pushes,
+//
+//   deflection = sum over front edges of w_e max(0, sin theta_e - mu cos theta_e) / sum of w_e,
+//
+// w_e the edge's width across the motion. A blade square to the motion deflects nothing (its
+// pile is carried whole, and the berms are what erosion spills off the flanks between stamps);
+// a disk deflects 1 / (2 (1 + mu^2)) - mu (pi/2 - theta_0 - sin(2 theta_0) / 2) / 2, theta_0 = atan mu:
+// 0.22 for the particles' mu = 0.5, its sand flowing round its curved front into its berms. The
+// default mu is infinite (nothing deflects): see RimRule::face_friction.
 // Then it heaps its cut and what it picked up as one pile, ahead of the pose and beside the tool
 // back to its rear (not in the trench the tool's rear half sweeps), at the angle of repose
 // falling away from the tool's front face (d: the distance to the footprint's edges that face
 // the motion), so the flanks slope down backwards along the tool instead of standing as a wall
-// that erosion pours into the trench. The state between stamps is that pile's elements and their
+// that erosion pours into the trench. Beside the tool the pile starts beyond the band the
+// trench's walls take as they slump (slump_band): put on it, the flanks went into the trench
+// with the walls, and the trench filled into a V where the grains' stays open.
+// The state between stamps is that pile's elements and their
 // heights before the deposit, which each back-end keeps; picking up measures what it takes, so
 // the volume stays exact.
 #include <cstdint>
@@ -55,8 +70,19 @@ struct PileSample {
 // Whether p takes part in a bulldozing stamp's front pile: outside the footprint (the caller
 // knows), ahead of the pose along the motion and within the footprint's half width across it;
 // for a carrying stamp, anywhere ahead of the pose and, beside the footprint's width, back to its
-// rear. O(1).
-bool in_front_pile(const ToolStamp& s, const Vec2& p);
+// rear, but not within `slump_band_m` of its sides until past its front (slump_band). O(1).
+bool in_front_pile(const ToolStamp& s, const Vec2& p, double slump_band_m = 0.0);
+
+// Where a carrying stamp reads the bed: a step ahead of its front, where the pile it carries was
+// just picked up, so the height there is the bed's. O(1).
+Vec2 bed_probe(const ToolStamp& s, double step_m);
+
+// The band beside a carrying tool that its trench's walls take: a wall cut `depth` deep slumps
+// to the angle of repose about its mid-height (the sand above that line falls below it), so the
+// bed within depth / (2 tan(repose)) of the cut's edge goes into the trench, and any pile put on
+// it too. The pile beside the tool starts beyond it, where the grains put their berms. depth:
+// the bed's height at bed_probe above the tool's bottom; 0 for a stamp that does not carry. O(1).
+double slump_band(const ToolStamp& s, double bed_z_m);
 
 // The distance d of the pile's surface from the tool: to the footprint (bulldozing), or to its
 // edges that face the motion (carrying). The edges are chosen once, when it is made: O(footprint);
@@ -84,8 +110,12 @@ struct CarriedPileOrigin {
   Vec2 xy{0.0, 0.0};
 };
 
-// What a carrying stamp keeps of the pile `previous` heaped: (1 - shed)^(moved / length) when it
-// follows that stamp (the next generation) and moved at most its own length since, else 0 (a new
+// The share of the carried sand the stamp's front sends round the tool per its length travelled
+// (above): 0 for a stamp that does not carry. O(footprint).
+double front_deflection(const ToolStamp& s);
+
+// What a carrying stamp keeps of the pile `previous` heaped: ((1 - shed) (1 - deflection))^(moved /
+// length) when it follows that stamp (the next generation) and moved at most its own length since, else 0 (a new
 // stroke, or a tool that jumped, starts a new pile). O(1).
 double carried_fraction(const ToolStamp& s, const CarriedPileOrigin& previous);
 

@@ -50,7 +50,11 @@ std::string scene_key_meaning(const std::string& key) {
        "where a moving tool puts the cut sand: carried with it as a pile ahead of and beside it, bulldozed ahead of it "
        "at the angle of repose, or on a rim band around it"},
       {"tool.carry_shed_fraction",
-       "carry: the fraction of its pile the tool leaves behind per its own length travelled"},
+       "carry: the fraction of its pile the tool leaves behind per its own length travelled, besides what its front "
+       "deflects"},
+      {"tool.face_friction",
+       "carry: friction coefficient between the tool's faces and the sand; a front face turned more than its "
+       "arctangent from the motion sends sand round the tool (inf: nothing slides)"},
       {"tool.volume_m3", "pour: volume poured per stamp"},
       {"stroke.path_m", "polyline, m"},
       {"stroke.z_m", "tool bottom z at each waypoint (default: surface - depth)"},

@@ -151,6 +151,7 @@ void read_tool(Fields& f, Scene& s) {
     t.rim.forward_bias = f.number("tool.rim_forward_bias", 0.8, closed(0.0, 1.0));
     t.rim.model = *displacement_from(f.choice("tool.displacement", "carry", {"rim", "bulldoze", "carry"}));
     t.rim.carry_shed_fraction = f.number("tool.carry_shed_fraction", 0.0, closed(0.0, 1.0));
+    t.rim.face_friction = f.number("tool.face_friction", kInf, closed(0.0, kInf));
     t.rim.tan_repose = s.material.tan_critical();  // the front pile stands at the material's angle
   }
 

@@ -68,6 +68,7 @@ std::optional<std::string> ToolSpec::problem() const {
     p = "tool.rim_forward_bias = " + number(rim.forward_bias) + " must be in [0, 1]";
   if (!p && !(rim.carry_shed_fraction >= 0.0 && rim.carry_shed_fraction <= 1.0))
     p = "tool.carry_shed_fraction = " + number(rim.carry_shed_fraction) + " must be in [0, 1]";
+  if (!p && !(rim.face_friction >= 0.0)) p = "tool.face_friction = " + number(rim.face_friction) + " must be >= 0";
   return p;
 }
 

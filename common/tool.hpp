@@ -2,6 +2,7 @@
 // Tools: a footprint polygon plus a bottom profile, posed in the world; and the pour tool.
 // A ToolStamp is one application of a tool at one pose: the unit the back-ends consume.
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -42,9 +43,16 @@ struct RimRule {
   // Bulldoze: the slope the front pile stands at, the material's critical slope (scenes set it
   // from material.critical_angle_deg; this default is the material's default, 30 degrees).
   double tan_repose = 0.57735026918962573;
-  // Carry: the fraction of its pile a tool leaves behind per its own length travelled (0: the
-  // berms are only what erosion spills off the carried pile's flanks, as the particles show).
+  // Carry: the fraction of its pile a tool leaves behind per its own length travelled, besides
+  // what slides off its front (0: the berms are what erosion spills off the carried pile's
+  // flanks and what the front deflects, as the particles show).
   double carry_shed_fraction = 0.0;
+  // Carry: the Coulomb friction coefficient between the tool's faces and the sand. Sand against
+  // a front face turned more than atan(face_friction) from the motion slides along it, round the
+  // tool (front_deflection in common/front_pile.hpp). Infinite by default: the faces hold the
+  // sand and nothing slides, which the particle references favour (results/particles_bars.md,
+  // model `deflect`: the particles' own 0.5).
+  double face_friction = std::numeric_limits<double>::infinity();
 };
 
 struct ToolSpec {

@@ -34,6 +34,10 @@ import reference_file  # noqa: E402
 
 BACKENDS = ("grid", "sparse", "tin")
 DISPLACEMENTS = ("rim", "bulldoze", "carry")  # tool.displacement: every back-end runs with each
+# Variants of the default model that every back-end also runs with: name, the keys they set.
+# `deflect`: its front sends sand round the tool at the particles' own tool friction
+# (tool.face_friction, common/front_pile.hpp), which the default leaves infinite.
+VARIANTS = {"deflect": ("tool.face_friction=0.5",)}
 REFERENCES = sbrun.ROOT / "experiments" / "dem" / "references"
 STROKE_ROWS = [("floor_m", "trench floor, mm", 1e3), ("crest_left_m", "left crest, mm", 1e3),
                ("crest_right_m", "right crest, mm", 1e3), ("crest_left_from_edge_m", "left crest from tool edge, mm", 1e3),
@@ -220,10 +224,10 @@ def force_parameters(ctx, scene):
 def variants(default):
     """Labels and overrides: each back-end with the default model, then with each other one; and
     the model the report sets beside the default (the paper's rim, unless that is the default)."""
-    others = [d for d in DISPLACEMENTS if d != default]
+    models = {d: (f"tool.displacement={d}",) for d in DISPLACEMENTS if d != default} | VARIANTS
     labels = [(b, b, ()) for b in BACKENDS]
-    labels += [(f"{b} {other}", b, (f"tool.displacement={other}",)) for other in others for b in BACKENDS]
-    return labels, others
+    labels += [(f"{b} {name}", b, keys) for name, keys in models.items() for b in BACKENDS]
+    return labels, list(models)
 
 
 def cutting_window(t, x, y):
@@ -347,6 +351,7 @@ def run(ctx):
         cases.append(case)
     if not cases:
         return {"cases": [], "table": "", "figures": {}, "displacement": default, "compared": other, "others": others,
+                "variants": {},
                 "tool_force": "", "force_fit": {}, "bars": "", "bars_met": {}, "most_bars": None, "summary": {}}
     md = ctx.table("particles", ["case", "surface", "metric", "particles (mean ± sd over seeds)", *names], rows_csv)
     figures = {"sections": section_figure(ctx, cases, names), "difference": difference_figure(ctx, cases),
@@ -355,6 +360,7 @@ def run(ctx):
     sessions = {ref.case: model_forces(ctx, ref) for ref in refs if ref.forces}
     bars, met = bars_table(ctx, cases, names, default)
     out.update({"displacement": default, "compared": other, "others": others, "bars": bars, "bars_met": met,
+                "variants": {name: ", ".join(keys) for name, keys in VARIANTS.items()},
                 "most_bars": max(met, key=lambda m: met[m][0]) if met else None,
                 "tool_force": tool_force_table(ctx, refs, sessions),
                 "force_fit": haptic_calibration.run(ctx, refs, sessions, {ref.case: force_parameters(ctx, scene_of(ref))

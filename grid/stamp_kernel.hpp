@@ -105,7 +105,7 @@ struct FootprintCircles {
 // nodes, so the polygon's distance is taken only for nodes that may lie within the reach.
 template <class Store>
 std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, const FootprintCircles& circles,
-                                      double volume) {
+                                      double volume, double slump_band_m) {
   const GridLayout& layout = grid.layout();
   const double tan = s.rim.tan_repose;
   const double margin = 0.5 * std::min(layout.dx, layout.dy);  // rounding at the corridor's edges
@@ -124,7 +124,7 @@ std::vector<Deposit> front_pile_nodes(const Store& grid, const ToolStamp& s, con
     for (std::size_t iy = r.y0; !r.empty && iy <= r.y1; ++iy) {
       for (std::size_t ix = r.x0; ix <= r.x1; ++ix) {
         const Vec2 p = layout.position(ix, iy);
-        if (!in_front_pile(s, p)) continue;
+        if (!in_front_pile(s, p, slump_band_m)) continue;
         const double d2 = (p - circles.centre).squaredNorm();
         if (circles.inside(s, p, d2)) continue;
         if (std::sqrt(d2) - outer > reach) continue;  // a lower bound of its distance to the footprint
@@ -219,7 +219,10 @@ StampReport cut_and_push(Store& grid, const ToolStamp& s, std::vector<std::uint3
   const double volume = removed.value();
   // A bulldozing stamp's sand goes ahead of the tool; the rim takes it when nothing lies ahead
   // (the tool at the domain's far side) and for every other stamp.
-  if (s.bulldozes()) rim = front_pile_nodes(grid, s, circles, volume);
+  if (s.bulldozes()) {
+    const double band = slump_band(s, grid.height(bed_probe(s, std::max(layout.dx, layout.dy))));
+    rim = front_pile_nodes(grid, s, circles, volume, band);
+  }
   if (carried && s.carries() && !rim.empty()) {
     carried->origin = carried_origin(s);
     carried->base.reserve(rim.size());

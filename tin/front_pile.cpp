@@ -19,7 +19,7 @@ namespace {
 constexpr double kMaxLatticePoints = 65536.0;
 }  // namespace
 
-void TinTerrain::fill_pile_lattice(const StampWork& w, double reach, StampReport& report) {
+void TinTerrain::fill_pile_lattice(const StampWork& w, double reach, double band, StampReport& report) {
   const ToolStamp& s = w.tool;
   const Aabb2 region = intersection(bounds(s.footprint).expanded(reach), box_);
   const Vec2 size = region.hi - region.lo;
@@ -36,7 +36,7 @@ void TinTerrain::fill_pile_lattice(const StampWork& w, double reach, StampReport
   for (long j = first(1); j <= last(1); ++j) {
     for (long i = first(0); i <= last(0); ++i) {
       const Vec2 p = box_.lo + h * Vec2(static_cast<double>(i), static_cast<double>(j));
-      if (!inner.contains(p) || !in_front_pile(s, p) || s.contains(p)) continue;
+      if (!inner.contains(p) || !in_front_pile(s, p, band) || s.contains(p)) continue;
       if (distance_to_boundary(s.footprint, p) < w.gap + clear || distance(p) > reach) continue;
       const Location loc = locate(p);
       bool near = false;
@@ -57,13 +57,14 @@ bool TinTerrain::deposit_front_pile(StampWork& w, double deposit, StampReport& r
   const double tan = s.rim.tan_repose;
   double reach = std::max({front_pile_flat_reach(deposit, 2.0 * s.half_width_m, tan), s.rim.width_m, refine_m_});
   const PileDistance distance(s);
+  const double band = slump_band(s, surface_height(bed_probe(s, refine_m_)));
   std::vector<VertexHandle> found, pile;
   std::vector<PileSample> samples;
   double level = 0.0;
   std::size_t sampled_before = 0;
   // Each round at least 1.5 times wider: 64 outgrow any domain; the bound guards non-finite input.
   for (int round = 0; round < 64; ++round) {
-    fill_pile_lattice(w, reach, report);
+    fill_pile_lattice(w, reach, band, report);
     const Aabb2 window = bounds(s.footprint).expanded(reach);
     collect_vertices(intersection(window, box_), found);
     pile.clear();
@@ -71,7 +72,7 @@ bool TinTerrain::deposit_front_pile(StampWork& w, double deposit, StampReport& r
     double lowest = HUGE_VAL;
     for (VertexHandle v : found) {
       const Vec2 p = xy(v);
-      if (!in_front_pile(s, p) || w.in_footprint(p)) continue;
+      if (!in_front_pile(s, p, band) || w.in_footprint(p)) continue;
       const double d = distance(p);
       if (d > reach) continue;
       pile.push_back(v);

@@ -314,6 +314,7 @@ StampSchedule session_schedule(const Session& session, const ToolSpec& scene_too
     t.rim.model = scene_tool.rim.model;
     t.rim.tan_repose = scene_tool.rim.tan_repose;
     t.rim.carry_shed_fraction = scene_tool.rim.carry_shed_fraction;
+    t.rim.face_friction = scene_tool.rim.face_friction;
   }
   auto poses = std::make_shared<const Poses>(Poses{session.stamps, std::move(tools)});
   StampSchedule schedule;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -108,8 +109,9 @@ TEST(FrontPile, OnlyAheadOfThePoseOnAnyHeading) {
 
 // A carrying stamp's pile also takes the points beside the tool back to its rear, but not the
 // trench behind the pose within its width; its distance is from the faces that meet the motion,
-// so beside the tool it grows towards the rear. It carries on the pile of the stamp just before
-// it, keeping (1 - shed)^(moved / length), and no other.
+// so beside the tool it grows towards the rear; within the slump band beside the tool it puts
+// nothing until past its front. It carries on the pile of the stamp just before it, keeping
+// (1 - shed)^(moved / length), and no other.
 TEST(FrontPile, CarriedBesideTheToolFromStampToStamp) {
   ToolSpec t;
   t.shape = ToolShape::Box;
@@ -122,10 +124,21 @@ TEST(FrontPile, CarriedBesideTheToolFromStampToStamp) {
     const ToolStamp s = make_stamp(t, {centre, 0.0, heading}, dir, 7);
     EXPECT_TRUE(s.bulldozes() && s.carries());
     const auto point = [&](double along, double side) { return Vec2(centre + along * dir + side * across); };
-    EXPECT_TRUE(in_front_pile(s, point(0.05, 0.03))) << heading;                      // ahead, beside the width
-    EXPECT_TRUE(in_front_pile(s, point(-0.008, 0.02))) << heading;                    // beside the rear half
-    EXPECT_FALSE(in_front_pile(s, point(-0.012, 0.02))) << heading;                   // behind the rear
-    EXPECT_FALSE(in_front_pile(s, point(-0.005, 0.0))) << heading;                    // behind the pose, in the width
+    EXPECT_TRUE(in_front_pile(s, point(0.05, 0.03))) << heading;     // ahead, beside the width
+    EXPECT_TRUE(in_front_pile(s, point(-0.008, 0.02))) << heading;   // beside the rear half
+    EXPECT_FALSE(in_front_pile(s, point(-0.012, 0.02))) << heading;  // behind the rear
+    EXPECT_FALSE(in_front_pile(s, point(-0.005, 0.0))) << heading;   // behind the pose, in the width
+    // The slump band beside it: no pile within it until past the front.
+    EXPECT_TRUE(in_front_pile(s, point(-0.008, 0.017))) << heading;
+    EXPECT_FALSE(in_front_pile(s, point(-0.008, 0.017), 0.004)) << heading;  // beside the rear half
+    EXPECT_FALSE(in_front_pile(s, point(0.008, 0.017), 0.004)) << heading;   // beside the front half
+    EXPECT_TRUE(in_front_pile(s, point(-0.008, 0.02), 0.004)) << heading;    // beyond the band
+    EXPECT_TRUE(in_front_pile(s, point(0.012, 0.017), 0.004)) << heading;    // past the front
+    EXPECT_TRUE(in_front_pile(s, point(0.005, 0.01), 0.004)) << heading;     // ahead, within the width
+    // A wall cut 10 mm deep slumps about its mid-height: 5 mm / tan(repose) of the bed goes.
+    EXPECT_NEAR(slump_band(s, s.pose.bottom_z + 0.01), 0.005 / s.rim.tan_repose, 1e-15) << heading;
+    EXPECT_EQ(slump_band(s, s.pose.bottom_z - 0.001), 0.0) << heading;  // the tool above the bed
+    EXPECT_NEAR((bed_probe(s, 0.002) - centre).dot(dir), 0.012, 1e-12) << heading;
     EXPECT_NEAR(pile_distance(s, point(0.03, 0.0)), 0.02, 1e-12) << heading;          // from the front face
     EXPECT_NEAR(pile_distance(s, point(0.0, 0.02)), std::hypot(0.01, 0.005), 1e-12);  // from its corner
     EXPECT_NEAR(pile_distance(s, point(-0.008, 0.02)), std::hypot(0.018, 0.005), 1e-12);
@@ -142,6 +155,48 @@ TEST(FrontPile, CarriedBesideTheToolFromStampToStamp) {
   EXPECT_FALSE(b.carries());
   EXPECT_FALSE(carried_origin(b).valid);
   EXPECT_EQ(carried_fraction(b, carried_origin(make_stamp(t, {{-0.002, 0.0}, 0.0, 0.0}, {1.0, 0.0}, 0))), 0.0);
+  EXPECT_EQ(slump_band(b, 1.0), 0.0);  // only a carried pile keeps off the band
+}
+
+// The front's deflection is the width-weighted net sliding force, max(0, sin theta - mu cos theta),
+// over its faces: none for a blade square to the motion on any heading, the same for every face
+// of a blade turned 45 degrees, and a disk's closed form (front_pile.hpp) for any friction; a
+// carrying disk keeps (1 - deflection)^(moved / length) of its pile.
+TEST(FrontPile, TheFrontDeflectsByItsFacesTurnAndFriction) {
+  ToolSpec box;
+  box.shape = ToolShape::Box;
+  box.half_size_m = {0.01, 0.015};
+  box.rim.model = Displacement::Carry;
+  box.rim.face_friction = 0.5;
+  for (const double heading : {0.0, 0.6, 2.0, -2.5}) {
+    const Vec2 dir(std::cos(heading), std::sin(heading));
+    EXPECT_NEAR(front_deflection(make_stamp(box, {{0.1, 0.2}, 0.0, heading}, dir, 3)), 0.0, 1e-15) << heading;
+    // Turned 45 degrees from its motion: both front faces at 45 degrees.
+    const ToolStamp turned = make_stamp(box, {{0.1, 0.2}, 0.0, heading + std::numbers::pi / 4}, dir, 3);
+    EXPECT_NEAR(front_deflection(turned), (1.0 - 0.5) * std::sqrt(0.5), 1e-12) << heading;
+  }
+  ToolSpec disk;
+  disk.shape = ToolShape::Disk;
+  disk.radius_m = 0.02;
+  disk.sides = 4096;
+  disk.rim.model = Displacement::Carry;
+  for (const double mu : {0.0, 0.3, 0.5, 1.0, 10.0}) {
+    disk.rim.face_friction = mu;
+    const double theta0 = std::atan(mu);
+    const double closed_form =
+        std::max(0.0, 0.5 / (1.0 + mu * mu) - 0.5 * mu * (std::numbers::pi / 2 - theta0 - 0.5 * std::sin(2 * theta0)));
+    const ToolStamp s = make_stamp(disk, {{0.0, 0.0}, 0.0, 0.7}, {0.6, 0.8}, 5);
+    EXPECT_NEAR(front_deflection(s), closed_form, 1e-5) << mu;
+    const CarriedPileOrigin before = carried_origin(make_stamp(disk, {{-0.0012, -0.0016}, 0.0, 0.7}, {0.6, 0.8}, 4));
+    EXPECT_NEAR(carried_fraction(s, before), std::pow(1.0 - closed_form, 0.002 / 0.04), 1e-6) << mu;
+  }
+  disk.rim.face_friction = std::numeric_limits<double>::infinity();  // the default: the faces hold the sand
+  EXPECT_EQ(front_deflection(make_stamp(disk, {{0.0, 0.0}, 0.0, 0.0}, {1.0, 0.0}, 1)), 0.0);
+  EXPECT_EQ(ToolSpec{}.rim.face_friction, disk.rim.face_friction);
+  disk.rim.face_friction = 0.5;
+  EXPECT_NEAR(front_deflection(make_stamp(disk, {{0.0, 0.0}, 0.0, 0.0}, {1.0, 0.0}, 1)), 0.2232, 1e-4);
+  disk.rim.model = Displacement::Bulldoze;  // not carried: nothing to deflect
+  EXPECT_EQ(front_deflection(make_stamp(disk, {{0.0, 0.0}, 0.0, 0.0}, {1.0, 0.0}, 1)), 0.0);
 }
 
 // The level holds exactly the volume asked for over the samples given, whatever their order,

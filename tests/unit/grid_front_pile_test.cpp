@@ -24,7 +24,8 @@ using stamp_detail::FootprintCircles;
 
 // The search by brute force: each round samples every node of the grid ahead of the tool,
 // outside its footprint and within the reach, and widens the reach as the kernel does.
-std::map<std::uint32_t, double> pile_over_every_node(const HeightGrid<double>& g, const ToolStamp& s, double volume) {
+std::map<std::uint32_t, double> pile_over_every_node(const HeightGrid<double>& g, const ToolStamp& s, double volume,
+                                                     double band) {
   const GridLayout& layout = g.layout();
   const double tan = s.rim.tan_repose;
   double reach = std::max({front_pile_flat_reach(volume, 2.0 * s.half_width_m, tan), s.rim.width_m, layout.diagonal()});
@@ -36,7 +37,7 @@ std::map<std::uint32_t, double> pile_over_every_node(const HeightGrid<double>& g
     for (std::size_t iy = 0; iy < layout.ny; ++iy)
       for (std::size_t ix = 0; ix < layout.nx; ++ix) {
         const Vec2 p = layout.position(ix, iy);
-        if (!in_front_pile(s, p) || s.contains(p)) continue;
+        if (!in_front_pile(s, p, band) || s.contains(p)) continue;
         const double d = pile_distance(s, p);
         if (d > reach) continue;
         const std::uint32_t k = layout.index(ix, iy);
@@ -82,29 +83,31 @@ TEST(GridFrontPile, TheCorridorFindsThePileOfEveryNodeAhead) {
       for (const double size : {0.0007, 0.004, 0.015}) {  // under a cell, a few cells, many
         for (const double heading_deg : {0.0, 90.0, 45.0, 200.0, 301.7}) {
           for (const Vec2& xy : {Vec2(0.1, 0.08), Vec2(0.185, 0.15)}) {  // mid-grid; the pile off the grid
-            for (const double volume : {1e-9, 2e-6, 4e-5}) {
-              const double a = heading_deg * std::numbers::pi / 180.0;
-              const Vec2 dir(std::cos(a), std::sin(a));
-              ToolPose pose;
-              pose.xy = xy;
-              pose.bottom_z = 0.04;
-              pose.heading_rad = a;
-              const ToolStamp s = make_stamp(tool(shape, size, model), pose, dir, 0);
-              const std::vector<Deposit> found = front_pile_nodes(grid, s, FootprintCircles(s), volume);
-              const std::map<std::uint32_t, double> expected = pile_over_every_node(grid, s, volume);
-              ASSERT_EQ(found.size(), expected.size()) << static_cast<int>(shape) << " " << size << " " << heading_deg;
-              for (const Deposit& d : found) {
-                const auto e = expected.find(d.node);
-                ASSERT_NE(e, expected.end()) << "node " << d.node << " is not under the pile";
-                EXPECT_NEAR(d.weight, e->second, 1e-12) << "node " << d.node;
+            for (const double volume : {1e-9, 2e-6, 4e-5})
+              for (const double band : {0.0, 0.006}) {  // the slump band beside a carrying tool
+                const double a = heading_deg * std::numbers::pi / 180.0;
+                const Vec2 dir(std::cos(a), std::sin(a));
+                ToolPose pose;
+                pose.xy = xy;
+                pose.bottom_z = 0.04;
+                pose.heading_rad = a;
+                const ToolStamp s = make_stamp(tool(shape, size, model), pose, dir, 0);
+                const std::vector<Deposit> found = front_pile_nodes(grid, s, FootprintCircles(s), volume, band);
+                const std::map<std::uint32_t, double> expected = pile_over_every_node(grid, s, volume, band);
+                ASSERT_EQ(found.size(), expected.size())
+                    << static_cast<int>(shape) << " " << size << " " << heading_deg;
+                for (const Deposit& d : found) {
+                  const auto e = expected.find(d.node);
+                  ASSERT_NE(e, expected.end()) << "node " << d.node << " is not under the pile";
+                  EXPECT_NEAR(d.weight, e->second, 1e-12) << "node " << d.node;
+                }
+                ++compared;
               }
-              ++compared;
-            }
           }
         }
       }
     }
-  EXPECT_EQ(compared, 2 * 3 * 3 * 5 * 2 * 3);
+  EXPECT_EQ(compared, 2 * 3 * 3 * 5 * 2 * 3 * 2);
 }
 
 }  // namespace

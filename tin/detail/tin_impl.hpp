@@ -322,8 +322,9 @@ class TinTerrain final : public Terrain {
                          const std::vector<std::pair<Vec2, double>>& base);
   // Vertices on a lattice of refine_m_ (anchored at the domain's corner, so stamps share it)
   // where the pile's region within `reach` of the footprint has none nearby: the pile's slopes
-  // resolved as erosion would resolve them, on a mesh that ahead of a tool is often coarse.
-  void fill_pile_lattice(const StampWork& w, double reach, StampReport& report);
+  // resolved as erosion would resolve them, on a mesh that ahead of a tool is often coarse (off
+  // the slump band beside the tool, front_pile.hpp, where no pile goes).
+  void fill_pile_lattice(const StampWork& w, double reach, double band, StampReport& report);
   // 1f: the vertices whose heights changed join L_e with their neighbours, and L_r; of the
   // retriangulated region's other vertices only those next to a face steeper than critical.
   void activate(const StampWork& w, const std::vector<VertexHandle>& region_vertices);
