@@ -50,8 +50,8 @@ struct RimRule {
   // Carry: the Coulomb friction coefficient between the tool's faces and the sand. Sand against
   // a front face turned more than atan(face_friction) from the motion slides along it, round the
   // tool (front_deflection in common/front_pile.hpp). Infinite by default: the faces hold the
-  // sand and nothing slides, which the particle references favour (results/particles_bars.md,
-  // model `deflect`: the particles' own 0.5).
+  // sand and nothing slides; the particles' own 0.5 meets no more of their bars
+  // (results/particles_bars.md, model `deflect`).
   double face_friction = std::numeric_limits<double>::infinity();
 };
 

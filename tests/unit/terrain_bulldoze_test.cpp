@@ -55,6 +55,7 @@ class Bulldoze : public ::testing::Test {
     double pile_volume_m3 = 0.0;  // above the bed, ahead of the pose at the end
     double berm_m = 0.0;          // highest point beside the trench's middle third, above the bed
     double berm_m3 = 0.0;         // sand above the bed there, both sides
+    double cut_m2 = 0.0;          // the trench's section below the bed there, averaged along it
   };
 
   Outcome drag(const Vec2& start, double heading_deg, const std::string& displacement = "displacement = \"bulldoze\"\n",
@@ -100,6 +101,11 @@ class Bulldoze : public ::testing::Test {
           out.berm_m = std::max(out.berm_m, above);
           out.berm_m3 += 0.002 * 0.001 * std::max(0.0, above);
         }
+    int sections = 0;
+    for (double along = kLength / 3; along <= 2 * kLength / 3; along += 0.002, ++sections)
+      for (double side = -0.06; side <= 0.06; side += 0.0005)
+        out.cut_m2 += 0.0005 * std::max(0.0, kBed - t->height(start + along * dir + side * across));
+    out.cut_m2 /= sections;
     if (!nothing_behind) return out;
     // Behind the start (beyond the rim's reach too): no sand put there. (The TIN's large flat
     // triangles there lean toward the vertices of the trench and its berms by some microns.)
@@ -156,6 +162,10 @@ TYPED_TEST(Carry, CarriesItsPileAndShedsItsBerms) {
   // The pile stands at the repose slope and is the same on another heading.
   for (const auto* out : {&keeps_all, &sheds, &turned})
     EXPECT_LE(out->steepest_ahead, std::tan(31.0 * std::numbers::pi / 180.0));
+  // The trench stays open as the grains' does (their section holds about the blade's width times
+  // its depth): the pile beside the blade starts beyond the band its walls take as they slump.
+  // Put on that band, the flanks slid into the trench with the walls and filled up to a fifth of it.
+  EXPECT_GT(keeps_all.cut_m2, 0.93 * 0.03 * kDepth);
   EXPECT_NEAR(turned.pile_height_m, sheds.pile_height_m, 0.15 * sheds.pile_height_m);
   EXPECT_NEAR(turned.pile_volume_m3, sheds.pile_volume_m3, 0.1 * sheds.pile_volume_m3);
 }
