@@ -97,13 +97,20 @@ class InteractiveScaling(unittest.TestCase):
                 ("tin", 1.0, None): self.stats(50.0, 1.0, 30.0, cells=0, vertices=900, stamps=0),
                 ("tin", 1.0, 0.0002): self.stats(45.0, 1.0, 40.0, cells=0, vertices=23000)}
         rows = {c: x.figures(c, s) for c, s in made.items()}
+        rounds = {c: [r] for c, r in rows.items()}
+        # Two more rounds of the 1 m bar cases: the step ratio 2.0, 1.4, 2.0 straddles its bar.
+        for step in (0.14, 0.2):
+            rounds[("grid", 1.0, 0.005)].append(x.figures(("grid", 1.0, 0.005), self.stats(20.0, 0.1, 40.0)))
+            rounds[("grid", 1.0, 0.001)].append(x.figures(("grid", 1.0, 0.001), self.stats(20.0, step, 60.0)))
         self.assertEqual(rows[("tin", 1.0, None)]["elements"], 900)
         self.assertNotEqual(rows[("tin", 1.0, None)]["latency_p95"], rows[("tin", 1.0, None)]["latency_p95"],
                             "no stamp, no latency (NaN)")
-        bars = {(b["bar"], b["backend"]): b["verdict"] for b in x.judge(rows)}
-        self.assertEqual(bars[("fps 1 mm / 5 mm", "grid")], "met")  # 1.0 against 0.8
-        self.assertEqual(bars[("sim step p95 1 mm / 5 mm", "grid")], "missed")  # 2.0
-        self.assertEqual(bars[("stamp to frame p95 at 1 mm", "grid")], "missed")
+        judged = x.judge(rounds)
+        bars = {(b["bar"], b["backend"]): b["verdict"] for b in judged}
+        self.assertEqual(bars[("fps 1 mm / 5 mm", "grid")], "met")  # 1.0 against 0.8, every round
+        self.assertEqual(bars[("sim step p95 1 mm / 5 mm", "grid")], "straddled: met in 1 of 3 runs")
+        self.assertEqual(judged[1]["measured"], "2 [1.4-2]")  # the rounds' median and range
+        self.assertEqual(bars[("stamp to frame p95 at 1 mm", "grid")], "missed")  # 60 ms, every round
         self.assertEqual(bars[("fps at 4096 x 4096", "grid")], "missed (within 10%)")  # 14 against 15
         self.assertEqual(bars[("stamp to frame, largest, at 4096 x 4096", "grid")], "missed (within 10%)")  # 108
         self.assertEqual(len(bars), 5, "no sparse rows, no sparse bars")
@@ -114,7 +121,8 @@ class InteractiveScaling(unittest.TestCase):
             ctx = types.SimpleNamespace(results=Path(tmp), table=lambda *a: sbrun.Context.table(ctx, *a),
                                         figure=lambda fig, name: sbrun.Context.figure(ctx, fig, name))
             sbrun.env_ok()
-            values = x.values(ctx, rows, "llvmpipe")
+            values = x.values(ctx, rounds, "llvmpipe")
+            self.assertEqual((values["met"], values["straddled"]), (1, 1))
             with open(Path(tmp) / "interactive_scaling.csv") as f:
                 table = list(csv.DictReader(f))
             self.assertEqual([(r["back-end"], r["terrain"]) for r in table],
