@@ -309,6 +309,9 @@ def values(ctx, rounds, renderer, costs=None):
                                       for c, f in zip(rounds[(b, *COARSE)], rounds[(b, *FINE)]))
                  for b in LATTICE_BACKENDS if (b, *FINE) in rows and (b, *COARSE) in rows and
                  all(c["step_cpu_p95"] > 0 for c in rounds[(b, *COARSE)])}
+    # The ratio's two sides (medians over the rounds): a cheaper 5 mm step raises it as a dearer 1 mm one does.
+    cpu_steps = {b: {size: statistics.median(r["step_cpu_p95"] for r in rounds[(b, *cell)])
+                     for size, cell in (("coarse", COARSE), ("fine", FINE))} for b in cpu_ratio}
     tin = [rows[c] for c in todo if c[0] == "tin" and c[1] == 1.0 and not on_dunes(c)]
     dunes = [rows[c] for c in todo if on_dunes(c)]
     return {"skipped": "", "png": png, "table": md, "renderer": renderer, "window": f"{WINDOW[0]} x {WINDOW[1]}",
@@ -319,7 +322,7 @@ def values(ctx, rounds, renderer, costs=None):
             "frames": FRAMES, "bars": bars, "bars_table": bars_table(bars) if bars else "",
             "met": sum(b["met"] for b in bars), "straddled": sum(b["straddled"] for b in bars),
             "rounds": BAR_ROUNDS, "rows": {case_name(c): r for c, r in rows.items()},
-            "costs": costs or {}, "summary": summary, "cpu_ratio": cpu_ratio}
+            "costs": costs or {}, "summary": summary, "cpu_ratio": cpu_ratio, "cpu_steps": cpu_steps}
 
 
 if __name__ == "__main__":

@@ -135,7 +135,7 @@ class InteractiveScaling(unittest.TestCase):
         self.assertIn("**Method or code:**", text)
         self.assertIn("llvmpipe", text)
         self.assertIn("on dunes 45 fps\nat 23000 vertices", text)
-        self.assertIn("CPU clock:\ngrid 2.00.", text)
+        self.assertIn("CPU clock:\ngrid 2.00 (0.050 ms at 5 mm, 0.100 at 1 mm).", text)
         self.assertIn("Skipped: no display", report.render("interactive_scaling", {"skipped": "no display"}))
 
 
