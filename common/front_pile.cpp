@@ -8,6 +8,14 @@
 
 namespace sb {
 
+namespace {
+
+// The cosine of the angle between a footprint edge's outward normal and the motion (the footprint
+// is counter-clockwise): positive for an edge that faces the motion; NaN for an edge of no length.
+double facing(const Vec2& edge, const Vec2& dir) { return (edge.y() * dir.x() - edge.x() * dir.y()) / edge.norm(); }
+
+}  // namespace
+
 bool in_front_pile(const ToolStamp& s, const Vec2& p, double slump_band_m) {
   const Vec2 offset = p - s.pose.xy;
   const double along = offset.dot(s.motion_dir);
@@ -32,9 +40,7 @@ double slump_band(const ToolStamp& s, double bed_z_m) {
 PileDistance::PileDistance(const ToolStamp& s) {
   const std::size_t n = s.footprint.size();
   for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
-    const Vec2 edge = s.footprint[i] - s.footprint[j];
-    const Vec2 outward(edge.y(), -edge.x());  // the footprint is counter-clockwise
-    if (!s.carries() || outward.dot(s.motion_dir) > 1e-9 * edge.norm())
+    if (!s.carries() || facing(s.footprint[i] - s.footprint[j], s.motion_dir) > 1e-9)
       edges_.emplace_back(s.footprint[j], s.footprint[i]);
   }
 }
@@ -74,12 +80,9 @@ double front_deflection(const ToolStamp& s) {
   const std::size_t n = s.footprint.size();
   for (std::size_t i = 0, j = n - 1; i < n; j = i++) {
     const Vec2 edge = s.footprint[i] - s.footprint[j];
-    const double length = edge.norm();
-    if (!(length > 0.0)) continue;
-    const Vec2 outward = Vec2(edge.y(), -edge.x()) / length;  // the footprint is counter-clockwise
-    const double cos_theta = outward.dot(s.motion_dir);
-    if (cos_theta <= 0.0) continue;  // not a front face
-    const double sin_theta = std::abs(outward.x() * s.motion_dir.y() - outward.y() * s.motion_dir.x());
+    const double cos_theta = facing(edge, s.motion_dir);
+    if (!(cos_theta > 0.0)) continue;  // not a front face (or no edge)
+    const double length = edge.norm(), sin_theta = std::abs(edge.dot(s.motion_dir)) / length;
     const double w = length * cos_theta;  // the edge's width across the motion
     width += w;
     sliding += w * std::max(0.0, sin_theta - mu * cos_theta);

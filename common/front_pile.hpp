@@ -47,10 +47,9 @@
 // the motion), so the flanks slope down backwards along the tool instead of standing as a wall
 // that erosion pours into the trench. Beside the tool the pile starts beyond the band the
 // trench's walls take as they slump (slump_band): put on it, the flanks went into the trench
-// with the walls, and the trench filled into a V where the grains' stays open.
-// The state between stamps is that pile's elements and their
-// heights before the deposit, which each back-end keeps; picking up measures what it takes, so
-// the volume stays exact.
+// with the walls, and the trench filled into a V where the grains' stays open. The state
+// between stamps is that pile's elements and their heights before the deposit, which each
+// back-end keeps; picking up measures what it takes, so the volume stays exact.
 #include <cstdint>
 #include <utility>
 #include <vector>

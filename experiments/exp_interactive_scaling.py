@@ -212,7 +212,7 @@ def plot(ctx, rows, renderer):
 
 def bar_cases(todo):
     """The cases the bars read, in table order."""
-    return [c for c in todo if c[0] in LATTICE_BACKENDS and c[1:] in (COARSE, FINE) or c == ("grid", *LARGE)]
+    return [c for c in todo if (c[0] in LATTICE_BACKENDS and c[1:] in (COARSE, FINE)) or c == ("grid", *LARGE)]
 
 
 def run_cases(ctx, todo):
