@@ -16,6 +16,11 @@ and each stamp shown within 100 ms. The bars' cases run BAR_ROUNDS times in inte
 runs of one round); a bar gives the rounds' median and range, and is met, missed, or straddled when some rounds
 meet it and some do not. The table shows each case's first run. The tiny profile runs the smallest grid case only.
 
+Where the 1 mm latency goes: "stamp to frame start" is a stamp's wait until the window takes it at the start of the
+frame that shows it (the rest of its latency is that frame's drawing), and in the bars' rounds the 1 mm grid is
+replayed once more without erosion (erosion.max_passes_per_step = 0): what the erosion after each stamp, on the
+same two cores as the software renderer, adds to the latency.
+
 One case by hand (the trajectory: haptics_trajectory.py TRAJ --centre 0.5 0.5 --wait-s 1.5 --hold-s 0.2 --stroke-s 1):
   xvfb-run -a -s '-screen 0 1280x768x24' sandbench interactive experiments/scenes/flat_stroke.toml --backend B
     --set 'domain.size_m=[1.0,1.0]' --set grid.cell_m=C --device replay:TRAJ --frames 200 --size 1280 720 --stats S
@@ -50,6 +55,8 @@ COST_REPEATS = 3
 # The bars' cases are replayed this many times, in rounds (every bar case once a round), so that a bar's verdict
 # says whether the runs' spread straddles it: on a shared 2-core machine one run flips a bar near its limit.
 BAR_ROUNDS = 3
+# Replayed in each round beside the bars' cases, with these overrides: the 1 mm grid without erosion.
+NO_EROSION = (("grid", *FINE), ["erosion.max_passes_per_step=0"])
 
 # (values key, table header, stats key)
 COLUMNS = [("fps", "fps", "fps"), ("frame_p50", "frame ms p50", "frame_ms.p50"),
@@ -57,6 +64,7 @@ COLUMNS = [("fps", "fps", "fps"), ("frame_p50", "frame ms p50", "frame_ms.p50"),
            ("latency_p50", "stamp to frame ms p50", "stamp_to_frame_ms.p50"),
            ("latency_p95", "stamp to frame ms p95", "stamp_to_frame_ms.p95"),
            ("latency_max", "stamp to frame ms max", "stamp_to_frame_ms.max"),
+           ("take_p95", "stamp to frame start ms p95", "stamp_to_take_ms.p95"),
            ("step_p50", "sim step ms p50", "sim.step_ms.p50"), ("step_p95", "sim step ms p95", "sim.step_ms.p95"),
            ("step_cpu_p95", "sim step CPU ms p95", "sim.step_cpu_ms.p95"),
            ("display_p50", "display ms p50", "display_ms.p50"), ("display_p95", "display ms p95", "display_ms.p95"), ("upload_p95", "upload ms p95", "upload_ms.p95"),
@@ -117,7 +125,7 @@ def figures(case, stats):
     row = {key: float(stats.get(name, float("nan"))) for key, _, name in COLUMNS}
     row["elements"] = int(stats["vertices"] if case[0] == "tin" else stats["cells"])
     if row["stamps"] == 0:
-        row["latency_p50"] = row["latency_p95"] = row["latency_max"] = float("nan")
+        row["latency_p50"] = row["latency_p95"] = row["latency_max"] = row["take_p95"] = float("nan")
     return row
 
 
@@ -217,8 +225,8 @@ def bar_cases(todo):
 
 def run_cases(ctx, todo):
     """{case: [stats dict of each run]}: each case replayed once, the bars' cases BAR_ROUNDS times in rounds (the
-    first round is every case's run); a run is reused when this binary already made it with these inputs (the stats
-    file is written whole or not at all)."""
+    first round is every case's run), and the NO_EROSION run in each round (under the key "no erosion"); a run is
+    reused when this binary already made it with these inputs (the stats file is written whole or not at all)."""
     import json
     folder = ctx.runs / "interactive_scaling" / "replays"
     folder.mkdir(parents=True, exist_ok=True)
@@ -231,16 +239,20 @@ def run_cases(ctx, todo):
             old.unlink()
         ctx.mark_current(folder, what)
     out = {}
-    runs = [(case, 0) for case in todo] + [(case, i) for i in range(1, BAR_ROUNDS) for case in bar_cases(todo)]
-    for case, i in runs:
-        name = case_name(case) + (f"-round{i + 1}" if i else "")
+    no_erosion = [NO_EROSION[0]] if NO_EROSION[0] in todo else []
+    runs = [(case, 0, False) for case in todo] + [(case, 0, True) for case in no_erosion]
+    runs += [(case, i, diag) for i in range(1, BAR_ROUNDS) for case, diag in
+             [(c, False) for c in bar_cases(todo)] + [(c, True) for c in no_erosion]]
+    for case, i, diag in runs:
+        name = case_name(case) + ("-no-erosion" if diag else "") + (f"-round{i + 1}" if i else "")
         stats = folder / f"{name}.json"
         if not stats.exists():
             sbrun.progress(f"  interactive_scaling: replaying on {name}")
             exp_haptics.run_interactive(ctx.sandbench, SCENE, case[0], trajectories[case[1]], stats,
-                                        overrides(case), FRAMES, WINDOW)
-        out.setdefault(case, []).append(json.loads(stats.read_text()))
-        if out[case][-1]["sim.stamps"] == 0:
+                                        overrides(case) + (NO_EROSION[1] if diag else []), FRAMES, WINDOW)
+        key = "no erosion" if diag else case
+        out.setdefault(key, []).append(json.loads(stats.read_text()))
+        if out[key][-1]["sim.stamps"] == 0:
             sbrun.progress(f"  interactive_scaling: no stamp on {name} (the run ended before the plunge)")
     return out
 
@@ -272,8 +284,9 @@ def run(ctx):
     todo = cases(ctx.profile_name)
     costs = stamp_costs(ctx, todo)  # first: the driver runs them on its engine before the replays
     stats = run_cases(ctx, todo)
+    no_erosion = [figures(NO_EROSION[0], s) for s in stats.pop("no erosion", [])]
     rounds = {c: [figures(c, s) for s in runs] for c, runs in stats.items()}
-    return values(ctx, rounds, renderer_of(s for runs in stats.values() for s in runs), costs)
+    return values(ctx, rounds, renderer_of(s for runs in stats.values() for s in runs), costs, no_erosion)
 
 
 def order(case):
@@ -282,9 +295,10 @@ def order(case):
     return BACKENDS.index(b), on_dunes(case), side, -(res or 0.0)
 
 
-def values(ctx, rounds, renderer, costs=None):
-    """The section's values from the runs ({case: [figures of each round]}) and the stamps' costs (stamp_costs):
-    figure, table (each case's first run), bars (every round), summary cells."""
+def values(ctx, rounds, renderer, costs=None, no_erosion=()):
+    """The section's values from the runs ({case: [figures of each round]}), the stamps' costs (stamp_costs) and
+    the NO_EROSION case's figures in each round: figure, table (each case's first run), bars (every round), summary
+    cells, where the 1 mm grid's latency goes."""
     import statistics
     rows = {c: runs[0] for c, runs in rounds.items()}
     todo = sorted(rows, key=order)
@@ -312,6 +326,14 @@ def values(ctx, rounds, renderer, costs=None):
     # The ratio's two sides (medians over the rounds): a cheaper 5 mm step raises it as a dearer 1 mm one does.
     cpu_steps = {b: {size: statistics.median(r["step_cpu_p95"] for r in rounds[(b, *cell)])
                      for size, cell in (("coarse", COARSE), ("fine", FINE))} for b in cpu_ratio}
+    # Where the 1 mm grid's latency p95 goes (medians and ranges over the rounds): the wait for the frame that
+    # shows a stamp, and what the erosion after the stamps adds (the same replay without erosion).
+    fine = rounds.get(NO_EROSION[0], [])
+
+    def spread(xs):
+        return {"median": statistics.median(xs), "lo": min(xs), "hi": max(xs)}
+    latency = ({"with": spread([r["latency_p95"] for r in fine]), "take": spread([r["take_p95"] for r in fine]),
+                "without": spread([r["latency_p95"] for r in no_erosion])} if fine and no_erosion else {})
     tin = [rows[c] for c in todo if c[0] == "tin" and c[1] == 1.0 and not on_dunes(c)]
     dunes = [rows[c] for c in todo if on_dunes(c)]
     return {"skipped": "", "png": png, "table": md, "renderer": renderer, "window": f"{WINDOW[0]} x {WINDOW[1]}",
@@ -322,7 +344,8 @@ def values(ctx, rounds, renderer, costs=None):
             "frames": FRAMES, "bars": bars, "bars_table": bars_table(bars) if bars else "",
             "met": sum(b["met"] for b in bars), "straddled": sum(b["straddled"] for b in bars),
             "rounds": BAR_ROUNDS, "rows": {case_name(c): r for c, r in rows.items()},
-            "costs": costs or {}, "summary": summary, "cpu_ratio": cpu_ratio, "cpu_steps": cpu_steps}
+            "costs": costs or {}, "summary": summary, "cpu_ratio": cpu_ratio, "cpu_steps": cpu_steps,
+            "latency": latency}
 
 
 if __name__ == "__main__":

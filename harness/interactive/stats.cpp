@@ -89,6 +89,9 @@ Json haptic_stats_json(const haptics::ServoStats& s, const haptics::DeviceLimits
   j["stamp_to_frame_ms.p50"] = percentile(info.stamp_to_frame_ms, 0.5);
   j["stamp_to_frame_ms.p95"] = percentile(info.stamp_to_frame_ms, 0.95);
   j["stamp_to_frame_ms.max"] = percentile(info.stamp_to_frame_ms, 1.0);
+  // The part of it spent before the frame that shows it began (the rest is that frame's drawing).
+  j["stamp_to_take_ms.p50"] = percentile(info.stamp_to_take_ms, 0.5);
+  j["stamp_to_take_ms.p95"] = percentile(info.stamp_to_take_ms, 0.95);
   j["backend"] = info.backend;
   j["device"] = info.device;
   j["gl_renderer"] = info.gl_renderer;

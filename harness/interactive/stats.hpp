@@ -21,6 +21,7 @@ struct InteractiveRunInfo {
   std::vector<double> frame_ms;           // every frame: swap to swap
   std::vector<double> upload_ms;          // every surface upload the window made
   std::vector<double> stamp_to_frame_ms;  // every stamp: applied to the swap of the first frame showing it
+  std::vector<double> stamp_to_take_ms;   // the same stamps: applied to the window taking it (its frame's start)
 };
 
 Json haptic_stats_json(const haptics::ServoStats& servo, const haptics::DeviceLimits& limits, const SimTotals& sim,

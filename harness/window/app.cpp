@@ -271,6 +271,7 @@ class WindowLoop {
     info.frame_ms = frame_ms_;
     info.upload_ms = upload_ms_;
     info.stamp_to_frame_ms = stamp_to_frame_ms_;
+    info.stamp_to_take_ms = stamp_to_take_ms_;
     if (replay_) info.device_force_max_n = replay_->max_commanded_force_n();
     if (mouse_device_) info.device_force_max_n = mouse_device_->max_commanded_force_n();
     if (!o_.stats.empty())
@@ -361,6 +362,8 @@ class WindowLoop {
       uploaded = true;
     }
     if (uploaded) upload_ms_.push_back(1e3 * sw.seconds());
+    const double taken_s = steady_seconds();
+    for (const double t : *stamp_times_s) stamp_to_take_ms_.push_back(1e3 * (taken_s - t));
     unshown_stamps_s_.insert(unshown_stamps_s_.end(), stamp_times_s->begin(), stamp_times_s->end());
   }
 
@@ -413,7 +416,7 @@ class WindowLoop {
   bool dragging_ = false;
   std::vector<std::uint8_t> screenshot_;
   int shot_w_ = 0, shot_h_ = 0;
-  std::vector<double> frame_ms_, upload_ms_, stamp_to_frame_ms_, unshown_stamps_s_;
+  std::vector<double> frame_ms_, upload_ms_, stamp_to_frame_ms_, stamp_to_take_ms_, unshown_stamps_s_;
 };
 
 }  // namespace

@@ -67,6 +67,7 @@ class InteractiveScaling(unittest.TestCase):
     def stats(fps, step_p95, latency_p95, cells=40401, vertices=0, stamps=23):
         return {"fps": fps, "frame_ms.p50": 1e3 / fps, "frame_ms.p99": 2e3 / fps, "stamp_to_frame_ms.p50": 0.5 *
                 latency_p95, "stamp_to_frame_ms.p95": latency_p95, "stamp_to_frame_ms.max": 1.2 * latency_p95,
+                "stamp_to_take_ms.p95": 0.4 * latency_p95,
                 "sim.step_ms.p50": 0.1, "sim.step_ms.p95": step_p95, "sim.step_cpu_ms.p95": 0.5 * step_p95,
                 "display_ms.p50": 0.05, "display_ms.p95": 0.1, "upload_ms.p95": 0.2, "sim.stamps": stamps, "sim.steps": 400, "cells": cells,
                 "vertices": vertices}
@@ -121,8 +122,11 @@ class InteractiveScaling(unittest.TestCase):
             ctx = types.SimpleNamespace(results=Path(tmp), table=lambda *a: sbrun.Context.table(ctx, *a),
                                         figure=lambda fig, name: sbrun.Context.figure(ctx, fig, name))
             sbrun.env_ok()
-            values = x.values(ctx, rounds, "llvmpipe")
+            no_erosion = [x.figures(x.NO_EROSION[0], self.stats(25.0, 1.5, lat)) for lat in (38.0, 45.0, 41.0)]
+            values = x.values(ctx, rounds, "llvmpipe", None, no_erosion)
             self.assertEqual((values["met"], values["straddled"]), (1, 1))
+            self.assertEqual(values["latency"]["without"], {"median": 41.0, "lo": 38.0, "hi": 45.0})
+            self.assertEqual(values["latency"]["take"]["median"], 24.0)  # 0.4 x 60 ms, every round
             with open(Path(tmp) / "interactive_scaling.csv") as f:
                 table = list(csv.DictReader(f))
             self.assertEqual([(r["back-end"], r["terrain"]) for r in table],
@@ -136,6 +140,10 @@ class InteractiveScaling(unittest.TestCase):
         self.assertIn("llvmpipe", text)
         self.assertIn("on dunes 45 fps\nat 23000 vertices", text)
         self.assertIn("CPU clock:\ngrid 2.00 (0.050 ms at 5 mm, 0.100 at 1 mm).", text)
+        self.assertIn("without erosion (`erosion.max_passes_per_step = 0`) 41 ms [38-45]\nagainst 60 [60-60] with it: the "
+                      "erosion after each stamp", text)
+        self.assertNotIn("takes the bar", report.render("interactive_scaling", dict(values, latency=dict(
+            values["latency"], without={"median": 55.0, "lo": 52.0, "hi": 58.0}))), "no claim when it misses without")
         self.assertIn("Skipped: no display", report.render("interactive_scaling", {"skipped": "no display"}))
 
 
