@@ -330,6 +330,7 @@ def run(ctx):
         final = surfaces()
         table, seeds, backends, base = case_rows(ref, scene, lattice, "final", final)
         case = {"case": ref.case, "scene": ref.scene, "mean": ref.mean("final"), "surfaces": final,
+                "grain_mm": 1e3 * ref.material()["grains"]["diameter_m"],
                 "x": ref.xs(), "y": ref.ys(), "backends": backends, "sections": None, "seeds": len(ref.seeds),
                 "dem_cost_s": float(np.median(ref.cpu_seconds())), "dem_seeds": seeds,
                 "critical": scene["material"]["critical_angle_deg"], "tool_depth_m": scene["tool"].get("depth_m"),
@@ -408,7 +409,7 @@ def values(cases, table, figures, other, others):
     report sets beside the default, `others` every model the back-ends also ran with."""
     out_cases, summary = [], {}
     for c in cases:
-        item = {"case": c["case"], "seeds": c["seeds"], "dem_cost_s": c["dem_cost_s"]}
+        item = {"case": c["case"], "seeds": c["seeds"], "dem_cost_s": c["dem_cost_s"], "grain_mm": c["grain_mm"]}
         if c["sections"] is not None:
             rmse = {b: c["backends"][b]["section_rmse_m"] for b in BACKENDS}
             speedup = [c["dem_cost_s"] / max(c["cost_s"][b], 1e-9) for b in BACKENDS]

@@ -9,7 +9,8 @@ Layout:
   in m, the upper envelope of the grains, stored to 10 um (HDF5's scale-offset filter);
 - `/force/seedN`: (samples, 7): time s, the tool bottom's centre x, y, z m, and the sand's force
   on the tool fx, fy, fz N;
-- `/provenance`: string datasets `material.toml`, `scene.toml`, `case.json`, and
+- `/provenance`: string datasets `material.toml`, `scene.toml`, `case.json` (its `material`
+  table, where it has one, overrides the material file's keys: case_material.py), and
   `inputs/seedN/STAGE.in` (the LAMMPS inputs as run); attribute `runs` (JSON: per seed its
   stages' wall and CPU seconds, grain counts and grain volumes per stage, and the bed's offset).
 Readers take the mean and spread over the seeds themselves."""
@@ -87,6 +88,13 @@ class Reference:
             self.forces = {k: f["force"][k][()].astype(float) for k in f["force"]}
             self.runs = json.loads(f["provenance"].attrs["runs"])
             self.material_text = f["provenance"]["material.toml"][()].decode()
+            self.case_spec = json.loads(f["provenance"]["case.json"][()].decode())
+
+    def material(self):
+        """The material the grains were run with: the material file and the case's own keys."""
+        import tomllib
+        from case_material import material_of
+        return material_of(self.case_spec, tomllib.loads(self.material_text))
 
     def mean(self, stage):
         return self.surfaces[stage].mean(axis=0)

@@ -34,6 +34,7 @@ ROOT = HERE.parent.parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent))
 import lammps_input  # noqa: E402
+from case_material import material_of  # noqa: E402
 import runstore  # noqa: E402
 import surface  # noqa: E402
 
@@ -68,7 +69,7 @@ def lmp_command(lmp, ranks):
 
 def specs_for(cases_path, cases, seeds, work, material_path, lmp, ranks):
     """One spec per case and seed; its key changes with everything the run depends on."""
-    material = json.dumps(load_toml(material_path), sort_keys=True)  # values, not comments
+    base = load_toml(material_path)
     all_cases = load_toml(cases_path)
     version = lammps_version(lmp) or "unknown"
     generator = "".join((HERE / f).read_text() for f in ("lammps_input.py", "surface.py"))
@@ -76,6 +77,7 @@ def specs_for(cases_path, cases, seeds, work, material_path, lmp, ranks):
     for name in cases:
         case = all_cases[name]
         scene = json.dumps(load_toml(ROOT / case["scene"]), sort_keys=True)
+        material = json.dumps(material_of(case, base), sort_keys=True)  # values, not comments
         for seed in seeds:
             key = hashlib.sha256("\0".join([material, scene, json.dumps(case, sort_keys=True), version,
                                             generator, str(seed)]).encode()).hexdigest()[:16]
@@ -114,8 +116,8 @@ def execute(spec):
     if folder.exists():
         shutil.rmtree(folder)
     folder.mkdir(parents=True)
-    material = load_toml(spec["material"])
     case = spec["case"]
+    material = material_of(case, load_toml(spec["material"]))
     scene = load_toml(ROOT / case["scene"])
     geo = lammps_input.Geometry(scene, material)
     raster = surface.Raster(geo.origin, geo.size, material["reference"]["raster_m"])
@@ -211,8 +213,9 @@ def main():
     args.seeds = args.seeds or load_toml(material_path)["reference"]["seeds"]
     for name in args.cases:  # every case's scene checked before any run starts
         try:
-            lammps_input.Geometry(load_toml(ROOT / all_cases[name]["scene"]), load_toml(material_path))
-        except (lammps_input.SceneError, OSError, KeyError, tomllib.TOMLDecodeError) as e:
+            lammps_input.Geometry(load_toml(ROOT / all_cases[name]["scene"]),
+                                  material_of(all_cases[name], load_toml(material_path)))
+        except (OSError, KeyError, ValueError) as e:  # SceneError and TOMLDecodeError are ValueErrors
             sys.stderr.write(f"run_dem: case {name} ({all_cases[name].get('scene', 'no scene')}): {e}\n")
             return 2
     if shutil.which(args.lmp) is None:

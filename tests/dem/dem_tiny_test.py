@@ -9,7 +9,9 @@ tool's force reduced and written to a reference file, which is read back and che
 - a second start finds the run done and runs nothing;
 - the tool is removed after it lifts and before the sand settles (a lifted tool left in place
   holds the back face of the pile it pushed);
-- a scene it cannot model is refused up front (exit 2, naming the key).
+- a scene it cannot model is refused up front (exit 2, naming the key);
+- a case's own material keys (another grain size) reach the run, its key and the reader; a key the
+  material file lacks is refused up front.
 Usage: dem_tiny_test.py (LAMMPS's `lmp` on PATH; the test is skipped, exit 77, without it)."""
 import shutil
 import subprocess
@@ -44,6 +46,38 @@ def refuses_what_it_cannot_model(tmp):
           f"an unsupported scene is refused naming terrain.kind ({proc.stderr.strip()})")
 
 
+def a_case_changes_its_grains(tmp):
+    """`material = {...}` in a case overrides the material file's keys for that case only: the
+    LAMMPS inputs and the run's key follow it; a misspelt key is refused before any run."""
+    import tomllib
+    import lammps_input
+    import run_dem
+    from case_material import material_of
+    with open(ROOT / "experiments" / "dem" / "material.toml", "rb") as f:
+        material = tomllib.load(f)
+    coarse = material_of({"material": {"grains": {"diameter_m": 0.003}}}, material)
+    check(coarse["grains"]["diameter_m"] == 0.003 and coarse["grains"]["diameter_spread"] ==
+          material["grains"]["diameter_spread"] and material["grains"]["diameter_m"] == 0.0025,
+          "a case's grain size overrides that key only, and leaves the material file's alone")
+    with open(ROOT / "tests" / "dem" / "tiny_scene.toml", "rb") as f:
+        scene = tomllib.load(f)
+    text = lammps_input.bed_input(lammps_input.Geometry(scene, coarse), coarse, 1)
+    check("0.003" in text and "0.0025" not in text, "the bed's LAMMPS input uses the case's grains")
+    cases = Path(tmp) / "grain_cases.toml"
+    cases.write_text('[a]\nscene = "tests/dem/tiny_scene.toml"\nspeed_m_per_s = 0.2\n'
+                     '[b]\nscene = "tests/dem/tiny_scene.toml"\nspeed_m_per_s = 0.2\n'
+                     'material = { grains = { diameter_m = 0.003 } }\n')
+    specs = run_dem.specs_for(cases, ["a", "b"], [1], Path(tmp), ROOT / "experiments" / "dem" / "material.toml",
+                              "lmp", 1)
+    check(specs[0]["key"] != specs[1]["key"], "the run's key changes with the case's grains")
+    cases.write_text('[bad]\nscene = "tests/dem/tiny_scene.toml"\nspeed_m_per_s = 0.2\n'
+                     'material = { grains = { diameter = 0.003 } }\n')
+    proc = subprocess.run(RUN_DEM[:2] + ["--cases-file", str(cases), "--work", f"{tmp}/grain-work", "--out",
+                                         f"{tmp}/grain-ref"], capture_output=True, text=True, timeout=120)
+    check(proc.returncode == 2 and "material.grains.diameter" in proc.stderr and not Path(tmp, "grain-ref").exists(),
+          f"a material key the file lacks is refused naming it ({proc.stderr.strip()})")
+
+
 def tool_leaves_before_the_sand_settles():
     """The generated stroke lifts the tool, removes it, then settles: the final surface is sand
     that stands on its own."""
@@ -66,6 +100,7 @@ def main():
     tool_leaves_before_the_sand_settles()
     with tempfile.TemporaryDirectory() as tmp:
         refuses_what_it_cannot_model(tmp)
+        a_case_changes_its_grains(tmp)
     if shutil.which("lmp") is None:
         print("lmp not found: skipped (Debian: lammps, installed by .ci/deps.sh)")
         return 77
