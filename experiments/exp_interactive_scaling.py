@@ -68,7 +68,8 @@ COLUMNS = [("fps", "fps", "fps"), ("frame_p50", "frame ms p50", "frame_ms.p50"),
            ("step_p50", "sim step ms p50", "sim.step_ms.p50"), ("step_p95", "sim step ms p95", "sim.step_ms.p95"),
            ("step_cpu_p95", "sim step CPU ms p95", "sim.step_cpu_ms.p95"),
            ("display_p50", "display ms p50", "display_ms.p50"), ("display_p95", "display ms p95", "display_ms.p95"), ("upload_p95", "upload ms p95", "upload_ms.p95"),
-           ("stamps", "stamps", "sim.stamps"), ("steps", "sim steps", "sim.steps")]
+           ("stamps", "stamps", "sim.stamps"), ("steps", "sim steps", "sim.steps"),
+           ("sim_cpu_s", "sim CPU s", "sim.step_cpu_s.total")]
 
 
 def cases(profile_name):
@@ -332,8 +333,11 @@ def values(ctx, rounds, renderer, costs=None, no_erosion=()):
 
     def spread(xs):
         return {"median": statistics.median(xs), "lo": min(xs), "hi": max(xs)}
+    coarse = rounds.get(("grid", *COARSE), [])
     latency = ({"with": spread([r["latency_p95"] for r in fine]), "take": spread([r["take_p95"] for r in fine]),
-                "without": spread([r["latency_p95"] for r in no_erosion])} if fine and no_erosion else {})
+                "without": spread([r["latency_p95"] for r in no_erosion]),
+                "sim_cpu_s": spread([r["sim_cpu_s"] for r in fine]),
+                "sim_cpu_s_coarse": spread([r["sim_cpu_s"] for r in coarse or fine])} if fine and no_erosion else {})
     tin = [rows[c] for c in todo if c[0] == "tin" and c[1] == 1.0 and not on_dunes(c)]
     dunes = [rows[c] for c in todo if on_dunes(c)]
     return {"skipped": "", "png": png, "table": md, "renderer": renderer, "window": f"{WINDOW[0]} x {WINDOW[1]}",

@@ -152,6 +152,7 @@ void Simulation::step() {
       erosion_ms = 1e3 * sw.seconds();
       add_volume(er.volume_change_m3);
       active_set_ = er.active;
+      totals_.erosion_updates += er.updates;
       changed |= er.transfers > 0;
     }
     if (active_.simplify && (stamped || changed)) {

@@ -50,10 +50,11 @@ struct SimStatus {
 // Whole-run figures for the statistics file.
 struct SimTotals {
   std::uint64_t steps = 0, stamps = 0, patches = 0;
-  std::vector<double> step_ms;      // every working step: stamp + erode + simplify
-  std::vector<double> step_cpu_ms;  // the same steps on the simulation thread's CPU clock (no waiting for a core)
-  std::vector<double> patch_ms;     // every publication
-  std::vector<double> display_ms;   // every surface publication to the window (DisplayFeed::publish)
+  std::uint64_t erosion_updates = 0;  // element visits of every erosion call (ErosionReport::updates)
+  std::vector<double> step_ms;        // every working step: stamp + erode + simplify
+  std::vector<double> step_cpu_ms;    // the same steps on the simulation thread's CPU clock (no waiting for a core)
+  std::vector<double> patch_ms;       // every publication
+  std::vector<double> display_ms;     // every surface publication to the window (DisplayFeed::publish)
   ModelStats final_stats;
   double volume_initial_m3 = 0.0, volume_final_m3 = 0.0, volume_added_m3 = 0.0;
   double volume_tracked_m3 = 0.0;  // initial plus the phases' reported changes (what the panel showed)

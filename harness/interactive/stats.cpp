@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <numeric>
 
 #include "common/atomic_file.hpp"
 #include "common/metrics.hpp"
@@ -59,6 +60,8 @@ Json haptic_stats_json(const haptics::ServoStats& s, const haptics::DeviceLimits
   j["passivity.ticks_bounded"] = s.passivity_ticks_bounded;
   j["sim.steps"] = sim.steps;
   j["sim.stamps"] = sim.stamps;
+  j["sim.erosion_updates"] = sim.erosion_updates;
+  j["sim.step_cpu_s.total"] = std::accumulate(sim.step_cpu_ms.begin(), sim.step_cpu_ms.end(), 0.0) * 1e-3;
   j["sim.step_ms.p50"] = percentile(sim.step_ms, 0.5);
   j["sim.step_ms.p95"] = percentile(sim.step_ms, 0.95);
   j["sim.step_ms.max"] = sim.step_ms.empty() ? 0.0 : *std::max_element(sim.step_ms.begin(), sim.step_ms.end());

@@ -124,6 +124,8 @@ TEST_F(Window, ReplayDeviceOnBothBackEndsRecordsASessionThatRunReplays) {
     EXPECT_EQ(s["frames"], 150);
     EXPECT_GT(s["ticks_in_contact"].get<double>(), 0.0) << backend;
     EXPECT_GT(s["sim.stamps"].get<double>(), 0.0) << backend;
+    EXPECT_GT(s["sim.step_cpu_s.total"].get<double>(), 0.0) << backend;
+    EXPECT_GT(s["sim.erosion_updates"].get<double>(), 0.0) << backend;
     // A stamp is taken by the window at the start of the frame that shows it: never after that frame's swap.
     for (const char* q : {"p50", "p95"}) {
       EXPECT_GE(s[std::string("stamp_to_take_ms.") + q].get<double>(), 0.0) << backend;
