@@ -4,8 +4,8 @@ back-end, in a 1280 x 720 window under xvfb-run.
 
 One plunge-and-stroke (haptics_trajectory.py: wait 3 mm above the sand, plunge 1 cm in, stroke 0.1 m along the
 diagonal, lift), centred on the domain, is replayed through `sandbench interactive` on flat_stroke.toml's sand
-over square domains of 1 m (cells of 10, 5, 2 and 1 mm: 1e4 to 1e6 grid nodes) and 2.0475 m at 0.5 mm (4096 x
-4096 nodes); the TIN on the same domains, its element count its vertex count at the end (the stats'). Each run
+over square domains of 1 m (cells of 10, 5, 2 and 1 mm: 1e4 to 1e6 grid nodes), of 0.25 and 2 m at 1 mm (what
+grows with the domain at one cell size) and 2.0475 m at 0.5 mm (4096 x 4096 nodes); the TIN on the same domains, its element count its vertex count at the end (the stats'). Each run
 draws FRAMES frames and its --stats JSON gives every figure; the renderer is the stats' `gl_renderer`
 (glGetString(GL_RENDERER)), "unknown" from a binary that does not write it. Beside the replays, `sandbench run`
 strokes the same path at 5 and 1 mm: what its stamps touch and what they and their erosion cost, without a window.
@@ -44,7 +44,8 @@ MOTION = {"wait_s": 1.5, "hold_s": 0.2, "stroke_s": 1.0}
 # (domain side m, grid cell m) per profile; the TIN runs once per side on the flat sand, and on dunes (a TIN
 # grows with what the terrain holds, not with the domain) at each of DUNES_TOLERANCES on the 1 m square.
 DOMAINS = {"tiny": [(1.0, 0.01)],
-           "paper": [(1.0, 0.01), (1.0, 0.005), (1.0, 0.002), (1.0, 0.001), (2.0475, 0.0005)]}
+           "paper": [(1.0, 0.01), (1.0, 0.005), (1.0, 0.002), (1.0, 0.001), (0.25, 0.001), (2.0, 0.001),
+                     (2.0475, 0.0005)]}
 DUNES = ["terrain.kind=dunes", "terrain.wavelength_m=0.1"]
 DUNES_TOLERANCES = {"tiny": [], "paper": [0.0004, 0.0002, 0.0001]}  # tin.tolerance_m
 TINY_BACKENDS = ("grid",)
@@ -338,6 +339,10 @@ def values(ctx, rounds, renderer, costs=None, no_erosion=()):
                 "without": spread([r["latency_p95"] for r in no_erosion]),
                 "sim_cpu_s": spread([r["sim_cpu_s"] for r in fine]),
                 "sim_cpu_s_coarse": spread([r["sim_cpu_s"] for r in coarse or fine])} if fine and no_erosion else {})
+    # The step at one cell size (the bars' fine one) on domains of several sizes: what grows with the domain.
+    same_cell = {b: [(c[1], rows[c]["step_cpu_p95"]) for c in todo if c[0] == b and c[2] == FINE[1]]
+                 for b in LATTICE_BACKENDS}
+    same_cell = {b: v for b, v in same_cell.items() if len(v) > 1}
     tin = [rows[c] for c in todo if c[0] == "tin" and c[1] == 1.0 and not on_dunes(c)]
     dunes = [rows[c] for c in todo if on_dunes(c)]
     return {"skipped": "", "png": png, "table": md, "renderer": renderer, "window": f"{WINDOW[0]} x {WINDOW[1]}",
@@ -349,7 +354,7 @@ def values(ctx, rounds, renderer, costs=None, no_erosion=()):
             "met": sum(b["met"] for b in bars), "straddled": sum(b["straddled"] for b in bars),
             "rounds": BAR_ROUNDS, "rows": {case_name(c): r for c, r in rows.items()},
             "costs": costs or {}, "summary": summary, "cpu_ratio": cpu_ratio, "cpu_steps": cpu_steps,
-            "latency": latency}
+            "latency": latency, "same_cell": same_cell}
 
 
 if __name__ == "__main__":

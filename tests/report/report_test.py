@@ -80,8 +80,9 @@ class InteractiveScaling(unittest.TestCase):
         self.assertIn(("sparse",) + x.COARSE, paper)
         self.assertIn(("grid",) + x.LARGE, paper)
         self.assertEqual([c for c in paper if c[0] == "tin"],
-                         [("tin", 1.0, None), ("tin", 2.0475, None), ("tin", 1.0, 0.0004), ("tin", 1.0, 0.0002),
-                          ("tin", 1.0, 0.0001)])
+                         [("tin", 1.0, None), ("tin", 0.25, None), ("tin", 2.0, None), ("tin", 2.0475, None),
+                          ("tin", 1.0, 0.0004), ("tin", 1.0, 0.0002), ("tin", 1.0, 0.0001)])
+        self.assertIn(("grid", 0.25, 0.001), paper)
         self.assertEqual(x.overrides(("grid", 1.0, 0.001)), ["domain.size_m=[1.0, 1.0]", "grid.cell_m=0.001"])
         self.assertEqual(x.overrides(("tin", 1.0, 0.0002)), ["domain.size_m=[1.0, 1.0]", "terrain.kind=dunes",
                                                                "terrain.wavelength_m=0.1", "tin.tolerance_m=0.0002"])
@@ -95,6 +96,7 @@ class InteractiveScaling(unittest.TestCase):
         import sbrun
         made = {("grid", 1.0, 0.005): self.stats(20.0, 0.1, 40.0), ("grid", 1.0, 0.001): self.stats(20.0, 0.2, 60.0),
                 ("grid", 2.0475, 0.0005): self.stats(14.0, 3.0, 90.0, cells=4096 ** 2),
+                ("grid", 0.25, 0.001): self.stats(20.0, 0.18, 50.0, cells=251001),
                 ("tin", 1.0, None): self.stats(50.0, 1.0, 30.0, cells=0, vertices=900, stamps=0),
                 ("tin", 1.0, 0.0002): self.stats(45.0, 1.0, 40.0, cells=0, vertices=23000)}
         rows = {c: x.figures(c, s) for c, s in made.items()}
@@ -130,16 +132,19 @@ class InteractiveScaling(unittest.TestCase):
             with open(Path(tmp) / "interactive_scaling.csv") as f:
                 table = list(csv.DictReader(f))
             self.assertEqual([(r["back-end"], r["terrain"]) for r in table],
-                             [("grid", "flat")] * 3 + [("tin", "flat"), ("tin", "dunes")])
+                             [("grid", "flat")] * 4 + [("tin", "flat"), ("tin", "dunes")])
             self.assertEqual(float(table[1]["fps"]), 20.0)
-            self.assertEqual(int(table[2]["elements"]), 4096 ** 2)
+            self.assertEqual(int(table[3]["elements"]), 4096 ** 2)
             self.assertTrue((Path(tmp) / values["png"]).stat().st_size > 0)
         text = report.render("interactive_scaling", values)
         self.assertIn("**Verdict.**", text)
         self.assertIn("**Method or code:**", text)
         self.assertIn("llvmpipe", text)
         self.assertIn("dunes\n45 fps at 23000 vertices", text)
-        self.assertIn("CPU clock:\ngrid 2.00 (0.050 to 0.100 ms).", text)
+        self.assertIn("CPU clock:\ngrid 2.00 (0.050 to 0.100 ms). The grid's at 1 mm on\n0.25, 1 m squares: 0.090, 0.100 ms "
+                      "(the domain's size does not enter).", text)
+        grows = dict(values, same_cell={"grid": [(0.25, 0.09), (1.0, 0.2)]})
+        self.assertIn("(it grows with the domain)", report.render("interactive_scaling", grows))
         self.assertIn("60 [60-60] in all, 41 [38-45] without erosion\n(`erosion.max_passes_per_step = 0`): erosion shares two "
                       "cores with the renderer (the\nsimulation's CPU over the replay: 4.00 s at 1 mm, 2.00 at 5 mm).", text)
         self.assertNotIn("erosion shares", report.render("interactive_scaling", dict(values, latency=dict(
