@@ -5,7 +5,8 @@ back-end, in a 1280 x 720 window under xvfb-run.
 One plunge-and-stroke (haptics_trajectory.py: wait 3 mm above the sand, plunge 1 cm in, stroke 0.1 m along the
 diagonal, lift), centred on the domain, is replayed through `sandbench interactive` on flat_stroke.toml's sand
 over square domains of 1 m (cells of 10, 5, 2 and 1 mm: 1e4 to 1e6 grid nodes), of 0.25 and 2 m at 1 mm (what
-grows with the domain at one cell size) and 2.0475 m at 0.5 mm (4096 x 4096 nodes); the TIN on the same domains, its element count its vertex count at the end (the stats'). Each run
+grows with the domain at one cell size) and 2.0475 m at 0.5 mm (4096 x 4096 nodes); the TIN on the same domains,
+its element count its vertex count at the end (the stats'). Each run
 draws FRAMES frames and its --stats JSON gives every figure; the renderer is the stats' `gl_renderer`
 (glGetString(GL_RENDERER)), "unknown" from a binary that does not write it. Beside the replays, `sandbench run`
 strokes the same path at 5 and 1 mm: what its stamps touch and what they and their erosion cost, without a window.
@@ -338,7 +339,7 @@ def values(ctx, rounds, renderer, costs=None, no_erosion=()):
     latency = ({"with": spread([r["latency_p95"] for r in fine]), "take": spread([r["take_p95"] for r in fine]),
                 "without": spread([r["latency_p95"] for r in no_erosion]),
                 "sim_cpu_s": spread([r["sim_cpu_s"] for r in fine]),
-                "sim_cpu_s_coarse": spread([r["sim_cpu_s"] for r in coarse or fine])} if fine and no_erosion else {})
+                "sim_cpu_s_coarse": spread([r["sim_cpu_s"] for r in coarse])} if fine and coarse and no_erosion else {})
     # The step at one cell size (the bars' fine one) on domains of several sizes: what grows with the domain.
     same_cell = {b: [(c[1], rows[c]["step_cpu_p95"]) for c in todo if c[0] == b and c[2] == FINE[1]]
                  for b in LATTICE_BACKENDS}
