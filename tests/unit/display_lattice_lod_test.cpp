@@ -65,7 +65,12 @@ TEST(LatticeLod, EveryCellIsDrawnOnceAroundAnyFocus) {
   for (const auto& [nx, ny] : std::vector<std::pair<std::size_t, std::size_t>>{{2, 2},
                                                                                {142, 142},
                                                                                {257, 100},
+                                                                               {161, 161},
+                                                                               {162, 161},
+                                                                               {201, 201},
+                                                                               {251, 251},
                                                                                {258, 258},
+                                                                               {5001, 3},
                                                                                {401, 401},
                                                                                {1001, 1001},
                                                                                {1001, 300},
@@ -84,6 +89,33 @@ TEST(LatticeLod, SmallLatticesAreOnePatchOfTheirOwnCells) {
   EXPECT_EQ(lattice_patch_cells(142, 100), (std::pair<std::size_t, std::size_t>{141, 99}));
   // Levelled: the triangles drawn do not grow with the lattice.
   EXPECT_LE(lattice_patches(4097, 4097, 2000, 2000).size(), lattice_patches(1001, 1001, 500, 500).size() + 2);
+}
+
+// The patch cells a lattice is drawn with (each patch's cells less its hole).
+std::size_t drawn_cells(std::size_t nx, std::size_t ny) {
+  const auto [cx, cy] = lattice_patch_cells(nx, ny);
+  std::size_t cells = 0;
+  for (const LatticePatch& p : lattice_patches(nx, ny, nx / 2, ny / 2))
+    cells += cx * cy - (p.hx1 - p.hx0) * (p.hy1 - p.hy0);
+  return cells;
+}
+
+TEST(LatticeLod, WholeOrLevelledByTheCellsNotBySide) {
+  // Drawn whole up to kFullCells cells, whatever the shape: the shipped scenes' lattices
+  // (141 x 141 cells the largest) and a long thin strip.
+  EXPECT_EQ(lattice_patches(142, 142, 70, 70).size(), 1u);
+  EXPECT_EQ(lattice_patches(161, 81, 80, 40).size(), 1u);
+  EXPECT_EQ(lattice_patches(161, 161, 80, 80).size(), 1u);
+  EXPECT_EQ(lattice_patches(5001, 3, 2500, 1).size(), 1u);
+  EXPECT_GT(lattice_patches(162, 161, 80, 80).size(), 1u);
+  // A small domain at a fine cell (0.25 m at 1 mm: 250 x 250 cells) costs no more to draw than a
+  // large one (1 m at 1 mm), and far fewer than its whole mesh.
+  EXPECT_LE(drawn_cells(251, 251), drawn_cells(1001, 1001));
+  EXPECT_LT(drawn_cells(251, 251), 250u * 250u / 2);
+  // No lattice is drawn with more cells than kFullCells until the levels of a very large domain
+  // add up to it (each level adds 3/4 of a patch).
+  for (const std::size_t n : {2u, 100u, 161u, 162u, 201u, 251u, 400u, 1001u, 2049u})
+    EXPECT_LE(drawn_cells(n, n), kFullCells) << n;
 }
 
 }  // namespace
