@@ -303,6 +303,57 @@ def tool_force_table(ctx, refs, sessions):
     return ctx.table("particles_tool_force", headers, rows)
 
 
+FLOOR_PARTS = 3  # the trench's floor is measured in this many stretches along the path
+
+
+def stretches(values_mm):
+    """'a / b / c' in tenths of a mm, without a negative zero."""
+    return " / ".join(f"{v:.1f}" if round(v, 1) != 0 else "0.0" for v in values_mm)
+
+
+def floor_along_table(ctx, cases):
+    """Where the trench's floor lies below the tool, along the trench: per stroke case, the tool's
+    width and depth and how far the axis lies below the tool's bottom (mm; negative: above it) in
+    each stretch of the trench, with the tool still in at the path's end and after it lifted, for
+    the grains' mean and the default model (grid; TIN lifted). Returns the Markdown and, per case,
+    the grains' stretches."""
+    rows, along = [], {}
+    for c in (c for c in cases if c["sections"] is not None):
+        stroke, depth = c["stroke"], c["tool_depth_m"]
+
+        def below(surface):
+            return [-(z + depth) * 1e3 for z in pm.floor_along(c["lattice"], surface, stroke, FLOOR_PARTS)]
+        grains = {stage: below(c["ref"].mean(stage)) for stage in ("tool_in", "final")}
+        model_tool_in = below(c["surfaces_tool_in"]["grid"])
+        along[c["case"]] = {"width_mm": 2e3 * stroke.half_width, "depth_mm": depth * 1e3,
+                            "tool_in_mm": grains["tool_in"], "lifted_mm": grains["final"], "model_tool_in_mm": model_tool_in}
+        rows.append([c["case"], f"{2e3 * stroke.half_width:.0f} x {depth * 1e3:.0f}", stretches(grains["tool_in"]),
+                     stretches(grains["final"]), stretches(model_tool_in),
+                     stretches(below(c["surfaces"]["grid"])), stretches(below(c["surfaces"]["tin"]))])
+    parts = " / ".join(("start", "middle", "end") if FLOOR_PARTS == 3 else [str(i + 1) for i in range(FLOOR_PARTS)])
+    headers = ["case", "tool width x depth, mm", f"grains, tool in: below the tool, mm ({parts})", "grains, lifted",
+               "grid, tool in", "grid, lifted", "TIN, lifted"]
+    return (ctx.table("particles_floor", headers, rows) if rows else ""), floor_trends(along)
+
+
+def floor_trends(along):
+    """What the report says of the floor along the trench, with the tool still in: how far below the
+    tool the grains lie where each cut starts (mm, min and max over the cases), and the tools'
+    widths (mm) whose trench's floor rises above the tool's bottom by its end and those whose floor
+    sinks further below it; the default model's (grid, tool in) least and most."""
+    if not along:
+        return {}
+    start = [a["tool_in_mm"][0] for a in along.values()]
+    risen = sorted({a["width_mm"] for a in along.values() if a["tool_in_mm"][-1] < 0})
+    sunk = [a for a in along.values() if a["tool_in_mm"][-1] > a["tool_in_mm"][0]]
+    model = [v for a in along.values() for v in a["model_tool_in_mm"]]
+    return {"cases": along, "start_min_mm": min(start), "start_max_mm": max(start), "risen_widths_mm": risen,
+            "model_min_mm": round(min(model), 1) + 0.0, "model_max_mm": round(max(model), 1) + 0.0,  # no "-0.0"
+            "sunk_widths_mm": sorted({a["width_mm"] for a in sunk}),
+            "sunk_end_min_mm": min((a["tool_in_mm"][-1] for a in sunk), default=math.nan),
+            "sunk_end_max_mm": max((a["tool_in_mm"][-1] for a in sunk), default=math.nan)}
+
+
 def run(ctx):
     refs = load_references()
     default = default_displacement(ctx)
@@ -336,7 +387,8 @@ def run(ctx):
                 "critical": scene["material"]["critical_angle_deg"], "tool_depth_m": scene["tool"].get("depth_m"),
                 "cost_s": {label: summaries[run_name(ref, label)]["time_s.total"] +
                            summaries[run_name(ref, label)].get("time_s.relax", 0.0) for label in names},
-                "dilation": dilation(ref, scene, lattice)}
+                "dilation": dilation(ref, scene, lattice), "lattice": lattice, "ref": ref,
+                "stroke": None if ref.case in POURS else stroke_of(scene)}
         if base is not None:
             case["sections"] = {"u": seeds[0]["section_u_m"], "seeds": [s["section_z_m"] for s in seeds],
                                 "backends": {label: backends[label]["section_z_m"] for label in names}}
@@ -347,12 +399,13 @@ def run(ctx):
             case["dem_self_rmse_m"] = float(np.mean([s["surface_rmse_m"] for s in seeds]))
         rows_csv += [[ref.case, "tool lifted"] + row for row in table]
         if base is not None:
-            tool_in, _, _, _ = case_rows(ref, scene, lattice, "tool_in", surfaces("-tool_in"))
+            case["surfaces_tool_in"] = surfaces("-tool_in")
+            tool_in, _, _, _ = case_rows(ref, scene, lattice, "tool_in", case["surfaces_tool_in"])
             rows_csv += [[ref.case, "tool in"] + row for row in tool_in]
         cases.append(case)
     if not cases:
         return {"cases": [], "table": "", "figures": {}, "displacement": default, "compared": other, "others": others,
-                "variants": {},
+                "variants": {}, "floor_table": "", "floor_along": {},
                 "tool_force": "", "force_fit": {}, "bars": "", "bars_met": {}, "most_bars": None, "summary": {}}
     md = ctx.table("particles", ["case", "surface", "metric", "particles (mean ± sd over seeds)", *names], rows_csv)
     figures = {"sections": section_figure(ctx, cases, names), "difference": difference_figure(ctx, cases),
@@ -360,6 +413,7 @@ def run(ctx):
     out = values(cases, md, figures, other, others)
     sessions = {ref.case: model_forces(ctx, ref) for ref in refs if ref.forces}
     bars, met = bars_table(ctx, cases, names, default)
+    out["floor_table"], out["floor_along"] = floor_along_table(ctx, cases)
     out.update({"displacement": default, "compared": other, "others": others, "bars": bars, "bars_met": met,
                 "variants": {name: ", ".join(keys) for name, keys in VARIANTS.items()},
                 "most_bars": max(met, key=lambda m: met[m][0]) if met else None,

@@ -98,6 +98,17 @@ def stroke_metrics(lattice, surface, stroke, initial=None):
     return out
 
 
+def floor_along(lattice, surface, stroke, parts=3):
+    """The trench floor (the axis band's mean height relative to the bed, as stroke_metrics's
+    floor) in `parts` equal stretches of the trench, from where the cut starts to the tool's
+    back at the path's end."""
+    u = np.arange(-0.25 * stroke.half_width, 0.25 * stroke.half_width + 1e-12, lattice.spacing / 2)
+    trench = (stroke.length - stroke.half_length) / stroke.length
+    edges = np.linspace(0.0, trench, parts + 1)
+    return [float(section(lattice, surface, stroke, u, band=(a, b)).mean() - stroke.bed)
+            for a, b in zip(edges[:-1], edges[1:])]
+
+
 def _room_across(lattice, stroke):
     """Twice the distance from the path's middle to the domain's border across the motion."""
     mid = stroke.start + stroke.dir * stroke.length / 2
