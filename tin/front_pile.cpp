@@ -118,7 +118,7 @@ double TinTerrain::pick_up_carried(StampWork& w, const CarriedPileOrigin& origin
     const double before = volume_change_;
     shift_z(v, z - dz, cached_area(v));
     taken -= volume_change_ - before;  // the measured change, as shift_z booked it
-    w.changed.push_back(v);
+    w.picked_up.push_back(p);          // a position: the stamp's retriangulation may remove v next
   }
   return taken;
 }

@@ -191,6 +191,10 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
     report.volume_change_m3 = volume_change_;
     return report;
   }
+  // What a carrying stamp picks up lies outside the footprint: taken before the stamp's
+  // retriangulation, which removes old vertices just outside it (1e) and with them the record
+  // of the sand they carried (the grids' cut leaves the nodes outside alone). Outside any capture.
+  const double picked = pick_up_carried(w, carried_origin, carried);
   if (w.cut) {
     contour_points(w);  // 1a
     find_constraints_near(w);
@@ -213,9 +217,12 @@ StampReport TinTerrain::stamp(const ToolStamp& s) {
   const double surface_change = measured.delta() + w.lowered_volume;
   // Constraint changes retriangulate inside the region, beyond the inserted vertices' stars.
   for (VertexHandle v : region_vertices) forget_caches(v);
+  // The carried pile's vertices the retriangulation kept changed height (the removed ones' faces
+  // are the region's).
+  for (const Vec2& p : w.picked_up)
+    if (const Location loc = locate(p); loc.type == Cdt::VERTEX) w.changed.push_back(loc.face->vertex(loc.index));
 
   // 1d (cont.): the displaced volume, and what the retriangulation changed (tin.conserve_volume).
-  const double picked = pick_up_carried(w, carried_origin, carried);
   const double deposit = picked + w.lowered_volume - (spec_.conserve_volume ? surface_change : 0.0) - stale_delta_;
   // (An uncut stamp that lowered nothing leaves the mesh as it was: no rim to refine.)
   report.volume_deposited_m3 = w.cut || deposit != 0.0 ? deposit_on_rim(w, deposit, report) : 0.0;

@@ -45,7 +45,8 @@ struct StampWork {
   std::vector<VertexHandle> fresh;                             // inserted by this stamp
   std::vector<VertexHandle> inside;                            // in the footprint
   std::vector<VertexHandle> changed;                           // heights changed (lowered or raised)
-  double lowered_volume = 0.0;                                 // taken out by 1d
+  std::vector<Vec2> picked_up;  // where the carried pile was taken, before the retriangulation
+  double lowered_volume = 0.0;  // taken out by 1d
 
   // footprint_bounds, inside_radius and reach_radius from the footprint and the rim. O(corners).
   void bound_footprint() {

@@ -316,8 +316,9 @@ class TinTerrain final : public Terrain {
   // region, each located) per widening of the region; one or two widenings are usual.
   bool deposit_front_pile(StampWork& w, double deposit, StampReport& report);
   // front_pile.cpp: what a carrying stamp keeps of the pile the stamp before it heaped
-  // (carried_), taken from its vertices outside the footprint that are still there; the volume
-  // taken (written outside any capture). O(that pile's vertices, each located).
+  // (carried_), taken from its vertices outside the footprint that are still there, before the
+  // stamp's retriangulation removes any (their positions into w.picked_up); the volume taken
+  // (written outside any capture). O(that pile's vertices, each located).
   double pick_up_carried(StampWork& w, const CarriedPileOrigin& origin,
                          const std::vector<std::pair<Vec2, double>>& base);
   // Vertices on a lattice of refine_m_ (anchored at the domain's corner, so stamps share it)
