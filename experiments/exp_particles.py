@@ -338,20 +338,28 @@ def floor_along_table(ctx, cases):
 
 def floor_trends(along):
     """What the report says of the floor along the trench, with the tool still in: how far below the
-    tool the grains lie where each cut starts (mm, min and max over the cases), and the tools'
-    widths (mm) whose trench's floor rises above the tool's bottom by its end and those whose floor
-    sinks further below it; the default model's (grid, tool in) least and most."""
+    tool the grains lie where each cut starts (mm, min and max over the cases); the trenches whose
+    floor rises above the tool's bottom by their end and those whose floor sinks further below it,
+    with their depth-to-width ratios (a wall's slump reaches a trench's axis when it is deep for its
+    width) and how far the sunk ones end below; the default model's (grid, tool in) least and most."""
     if not along:
         return {}
     start = [a["tool_in_mm"][0] for a in along.values()]
-    risen = sorted({a["width_mm"] for a in along.values() if a["tool_in_mm"][-1] < 0})
-    sunk = [a for a in along.values() if a["tool_in_mm"][-1] > a["tool_in_mm"][0]]
+    ratio = {case: a["depth_mm"] / a["width_mm"] for case, a in along.items()}
+    risen = [case for case, a in along.items() if a["tool_in_mm"][-1] < 0]
+    sunk = [case for case, a in along.items() if a["tool_in_mm"][-1] > a["tool_in_mm"][0]]
     model = [v for a in along.values() for v in a["model_tool_in_mm"]]
-    return {"cases": along, "start_min_mm": min(start), "start_max_mm": max(start), "risen_widths_mm": risen,
-            "model_min_mm": round(min(model), 1) + 0.0, "model_max_mm": round(max(model), 1) + 0.0,  # no "-0.0"
-            "sunk_widths_mm": sorted({a["width_mm"] for a in sunk}),
-            "sunk_end_min_mm": min((a["tool_in_mm"][-1] for a in sunk), default=math.nan),
-            "sunk_end_max_mm": max((a["tool_in_mm"][-1] for a in sunk), default=math.nan)}
+    out = {"cases": along, "start_min_mm": min(start), "start_max_mm": max(start), "risen": risen, "sunk": sunk,
+           "model_min_mm": round(min(model), 1) + 0.0, "model_max_mm": round(max(model), 1) + 0.0}  # no "-0.0"
+    if risen:
+        out["risen_ratio_min"] = min(ratio[c] for c in risen)
+    if sunk:
+        out["sunk_ratio_max"] = max(ratio[c] for c in sunk)
+        out["sunk_end_min_mm"] = min(along[c]["tool_in_mm"][-1] for c in sunk)
+        out["sunk_end_max_mm"] = max(along[c]["tool_in_mm"][-1] for c in sunk)
+    # The depth-to-width ratio tells them apart when every risen trench is deeper for its width than every sunk one.
+    out["by_ratio"] = bool(risen and sunk and out["risen_ratio_min"] > out["sunk_ratio_max"])
+    return out
 
 
 def run(ctx):
@@ -479,11 +487,6 @@ def values(cases, table, figures, other, others):
                          "verdict": ("the shared tool model: the back-ends agree far better with each other "
                                      "than with the grains" if shared else
                                      "partly the discretisation: back-ends differ by much of it")})
-            # Grains deeper than the tool by more than the floor's bar: no height field cut to the tool follows.
-            floor = float(np.mean([s["floor_m"] for s in c["dem_seeds"]]))
-            below = -floor - (c.get("tool_depth_m") or float("inf"))
-            if below > BARS[0][2]:
-                item["floor_below_tool_mm"] = below * 1e3
             for b in BACKENDS:  # the report's summary table joins the cases' cells
                 summary.setdefault(b, {}).setdefault("accuracy vs particle sand", [])
                 summary[b]["accuracy vs particle sand"].append(f"{c['case']} {rmse[b] * 1e3:.1f} mm")
@@ -497,7 +500,26 @@ def values(cases, table, figures, other, others):
         out_cases.append(item)
     summary = {b: {col: "section RMSE " + ", ".join(cells) for col, cells in cols.items()} for b, cols in summary.items()}
     verdicts = list(dict.fromkeys(c["verdict"] for c in out_cases if "verdict" in c))
-    return {"cases": out_cases, "table": table, "figures": figures, "summary": summary, "verdicts": verdicts}
+    return {"cases": out_cases, "table": table, "figures": figures, "summary": summary, "verdicts": verdicts,
+            "berms": berm_spread(cases)}
+
+
+def berm_spread(cases):
+    """The berms' section (mm^2, both sides, tool lifted) over the stroke cases: the grains' least and
+    most, their cuts' and the berms' share of them, the default model's on the grid, and the case where the
+    grid's falls furthest short of the grains' (its case, grid and grains mm^2)."""
+    strokes = [c for c in cases if c["sections"] is not None]
+    if not strokes:
+        return {}
+    grains = {c["case"]: np.mean([s["berm_area_m2"] for s in c["dem_seeds"]]) * 1e6 for c in strokes}
+    share = [np.mean([s["berm_cut_ratio"] for s in c["dem_seeds"]]) for c in strokes]
+    grid = {c["case"]: c["backends"]["grid"]["berm_area_m2"] * 1e6 for c in strokes}
+    cut = [np.mean([s["cut_area_m2"] for s in c["dem_seeds"]]) * 1e6 for c in strokes]
+    worst = min(grid, key=lambda k: grid[k] / grains[k])
+    return {"grains_min": min(grains.values()), "grains_max": max(grains.values()), "cut_min": min(cut),
+            "cut_max": max(cut), "share_min": min(share),
+            "share_max": max(share), "grid_min": min(grid.values()), "grid_max": max(grid.values()),
+            "worst": worst, "worst_grid": grid[worst], "worst_grains": grains[worst]}
 
 
 if __name__ == "__main__":

@@ -146,8 +146,7 @@ class InteractiveScaling(unittest.TestCase):
         grows = dict(values, same_cell={"grid": [(0.25, 0.09), (1.0, 0.2)]})
         self.assertIn("(it grows with the domain)", report.render("interactive_scaling", grows))
         self.assertIn("60 [60-60] in all, 41 [38-45] without erosion\n(`erosion.max_passes_per_step = 0`): erosion "
-                      "shares two cores with the renderer (the\nsimulation's CPU over the replay: 4.00 s at 1 mm, "
-                      "2.00 at 5 mm).", text)
+                      "shares two cores with the renderer (simulation\nCPU 4.00 s at 1 mm, 2.00 at 5 mm).", text)
         self.assertNotIn("erosion shares", report.render("interactive_scaling", dict(values, latency=dict(
             values["latency"], without={"median": 58.0, "lo": 52.0, "hi": 61.0}))),
             "no claim when the runs without erosion reach those with it")
