@@ -233,7 +233,7 @@ def run(ctx, refs, sessions, parameters):
         rows.append(row_of(case, data, direction, k0, b0, mu0))
         rows[-1][1:1] = ["shipped"]
         rows.append(row_of(case, data, direction, calibrated["k"], b_held, calibrated["mu"]))
-        rows[-1][1:1] = ["calibrated (cut, both cases, b held)"]
+        rows[-1][1:1] = ["calibrated (cut, every case, b held)"]
         for label, f in fits.items():
             row = row_of(case, data, direction, f["k"], f["b"], f["mu"], f["correlation"] if "free" in label else None)
             rows.append(row[:1] + [f"this case: {label}"] + row[1:])
