@@ -315,8 +315,8 @@ def floor_along_table(ctx, cases):
     """Where the trench's floor lies below the tool, along the trench: per stroke case, the tool's
     width and depth and how far the axis lies below the tool's bottom (mm; negative: above it) in
     each stretch of the trench, with the tool still in at the path's end and after it lifted, for
-    the grains' mean and the default model (grid; TIN lifted). Returns the Markdown and, per case,
-    the grains' stretches."""
+    the grains' mean and the default model (grid; TIN lifted). Returns the Markdown and what the
+    report says of it (floor_trends)."""
     rows, along = [], {}
     for c in (c for c in cases if c["sections"] is not None):
         stroke, depth = c["stroke"], c["tool_depth_m"]
@@ -326,7 +326,7 @@ def floor_along_table(ctx, cases):
         grains = {stage: below(c["ref"].mean(stage)) for stage in ("tool_in", "final")}
         model_tool_in = below(c["surfaces_tool_in"]["grid"])
         along[c["case"]] = {"width_mm": 2e3 * stroke.half_width, "depth_mm": depth * 1e3,
-                            "tool_in_mm": grains["tool_in"], "lifted_mm": grains["final"], "model_tool_in_mm": model_tool_in}
+                            "tool_in_mm": grains["tool_in"], "model_tool_in_mm": model_tool_in}
         rows.append([c["case"], f"{2e3 * stroke.half_width:.0f} x {depth * 1e3:.0f}", stretches(grains["tool_in"]),
                      stretches(grains["final"]), stretches(model_tool_in),
                      stretches(below(c["surfaces"]["grid"])), stretches(below(c["surfaces"]["tin"]))])
@@ -349,7 +349,7 @@ def floor_trends(along):
     risen = [case for case, a in along.items() if a["tool_in_mm"][-1] < 0]
     sunk = [case for case, a in along.items() if a["tool_in_mm"][-1] > a["tool_in_mm"][0]]
     model = [v for a in along.values() for v in a["model_tool_in_mm"]]
-    out = {"cases": along, "start_min_mm": min(start), "start_max_mm": max(start), "risen": risen, "sunk": sunk,
+    out = {"start_min_mm": min(start), "start_max_mm": max(start), "risen": risen, "sunk": sunk,
            "model_min_mm": round(min(model), 1) + 0.0, "model_max_mm": round(max(model), 1) + 0.0}  # no "-0.0"
     if risen:
         out["risen_ratio_min"] = min(ratio[c] for c in risen)

@@ -12,8 +12,8 @@
 // A lattice of at most kFullCells cells in all is drawn whole, in one patch of its own size: the
 // shipped scenes (smaller) look exactly as a full mesh (same vertices, same diagonals). The bound
 // is on the cells, not on a side, so that no lattice drawn whole costs more triangles than a
-// levelled one of a large domain (about 33 k at 1000 x 1000 nodes): a small lattice at a fine cell
-// is never the slower one to draw.
+// levelled one of a large domain (a patch of kLodCells^2 cells and 3/4 of one per coarser level):
+// a small lattice at a fine cell is never the slower one to draw.
 //
 // Pure arithmetic, O(levels); the window draws each patch from one shared index buffer.
 #include <cstddef>
